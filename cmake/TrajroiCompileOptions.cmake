@@ -1,0 +1,17 @@
+# Compile options shared by every trajroi target.
+#
+# -ffp-contract=off: the fast ROI filter must decide exactly as the paper's double loop.
+# Both evaluate the same inline expressions, but GCC may fuse a*b + c into an FMA in one
+# inlined copy and not in the other, which changes the last bit. Forbidding contraction
+# everywhere keeps every copy of an expression bit-identical.
+function(trajroi_target_defaults target)
+  target_compile_features(${target} PUBLIC cxx_std_20)
+  set_target_properties(${target} PROPERTIES CXX_EXTENSIONS OFF)
+  target_compile_options(${target} PRIVATE
+    -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wsign-conversion
+    -Wnon-virtual-dtor -Wold-style-cast -Wnull-dereference -Wdouble-promotion
+    -ffp-contract=off)
+  if(TRAJROI_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+endfunction()

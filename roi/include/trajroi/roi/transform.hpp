@@ -1,0 +1,26 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <span>
+
+#include "trajroi/roi/point.hpp"
+
+namespace trajroi::roi {
+
+// Naming: `a_from_b` maps coordinates given in frame b into frame a, so
+// global_from_sensor = global_from_robot * robot_from_sensor  (ᴳp = ᴳ_R T · ᴿ_S T · ˢp).
+
+// A planar pose as a 3-D isometry: translation (x_m, y_m, z_m), rotation yaw_rad about +z
+// (counter-clockwise from +x, REP-103).
+[[nodiscard]] Eigen::Isometry3d pose_from_xy_yaw(double x_m, double y_m, double yaw_rad,
+                                                 double z_m = 0.0);
+
+// out[i] = target_from_source · in[i] for every point, computed in double and stored in the
+// output's precision; intensity is copied. `in` and `out` must have the same size and may be
+// the same array (in-place). Allocates nothing.
+void transform_points(const Eigen::Isometry3d& target_from_source, std::span<const PointXYZI> in,
+                      std::span<PointXYZI> out);
+void transform_points(const Eigen::Isometry3d& target_from_source, std::span<const PointXYZd> in,
+                      std::span<PointXYZd> out);
+
+}  // namespace trajroi::roi

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Installs every Debian (bookworm) package trajroi builds, tests, benchmarks and runs with.
+# apt-get only; safe to run again. Must run as root (or through sudo).
+set -euo pipefail
+
+packages=(
+  # toolchain
+  build-essential cmake ninja-build pkg-config git
+  # libraries
+  libeigen3-dev libpcap-dev libgeographiclib-dev libserialport-dev libspdlog-dev
+  libyaml-cpp-dev libcli11-dev libsystemd-dev
+  # LCM: C/C++ library, lcm-gen, Java types for lcm-spy
+  liblcm-dev liblcm-bin liblcm-java libjchart2d-java default-jdk-headless
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+  # fuzzing and sanitizers (clang's libFuzzer and runtimes)
+  clang libclang-rt-14-dev
+  # systemd-analyze for the unit checks
+  systemd
+)
+
+if [ "$(id -u)" -ne 0 ]; then
+  SUDO=sudo
+else
+  SUDO=
+fi
+
+export DEBIAN_FRONTEND=noninteractive
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ "${#missing[@]}" -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages already installed"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,54 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace trajroi::eval {
+
+// A top-down SVG drawing of the global XY plane: +x right, +y up, metres scaled to pixels.
+// Builds the document in memory; str() returns it complete.
+class SvgCanvas {
+ public:
+  // The drawing covers [x_min, x_max] × [y_min, y_max] plus a margin, at px_per_m.
+  SvgCanvas(double x_min, double y_min, double x_max, double y_max, double px_per_m,
+            std::string_view title);
+
+  void dot(double x, double y, std::string_view colour, double size_px = 2.0);
+  void circle(double cx, double cy, double radius_m, std::string_view colour, double width_px = 1.0);
+  void polygon(std::span<const Eigen::Vector2d> corners, std::string_view colour,
+               double width_px = 1.0);
+  void polyline(std::span<const Eigen::Vector2d> points, std::string_view colour,
+                double width_px = 1.5);
+  // A legend entry in the top-left corner, one per call, in call order.
+  void legend(std::string_view colour, std::string_view label);
+
+  [[nodiscard]] std::string str() const;
+
+ private:
+  [[nodiscard]] double px(double x) const noexcept { return (x - x_min_) * scale_ + kMargin; }
+  [[nodiscard]] double py(double y) const noexcept { return (y_max_ - y) * scale_ + kMargin + kHeader; }
+
+  static constexpr double kMargin = 20.0;
+  static constexpr double kHeader = 30.0;
+  double x_min_;
+  double y_max_;
+  double scale_;
+  double width_px_;
+  double height_px_;
+  int legend_rows_ = 0;
+  std::string body_;
+  std::string overlay_;
+  std::string title_;
+};
+
+// Colours used for classified points everywhere, so pictures read the same.
+inline constexpr std::string_view kColourTp = "#2ca02c";   // kept, in the truth corridor
+inline constexpr std::string_view kColourFp = "#d62728";   // kept, outside it
+inline constexpr std::string_view kColourFn = "#ff7f0e";   // missed
+inline constexpr std::string_view kColourTn = "#c7c7c7";   // rightly dropped
+inline constexpr std::string_view kColourRoi = "#1f77b4";
+inline constexpr std::string_view kColourTrajectory = "#000000";
+
+}  // namespace trajroi::eval

@@ -1,0 +1,11 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace trajroi::cli {
+
+// Each adds one subcommand (with its options and its callback) to the application.
+void add_eval_commands(CLI::App& app);
+void add_filter_command(CLI::App& app);
+
+}  // namespace trajroi::cli

@@ -1,0 +1,155 @@
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "file_io.hpp"
+#include "trajroi/eval/points_csv.hpp"
+#include "trajroi/roi/cuboid.hpp"
+#include "trajroi/roi/grid_filter.hpp"
+#include "trajroi/roi/reference_filter.hpp"
+#include "trajroi/roi/shapes.hpp"
+#include "trajroi/roi/text.hpp"
+#include "trajroi/roi/transform.hpp"
+
+namespace trajroi::cli {
+namespace {
+
+struct FilterOptions {
+  std::string trajectory_path;
+  std::string points_path;
+  std::string shape;
+  std::optional<double> diameter_m;
+  std::optional<double> height_m;
+  std::optional<double> width_m;
+  std::optional<double> length_m;
+  std::optional<double> spacing_m;
+  std::optional<double> spacing_ratio;
+  double z_min_m = -std::numeric_limits<double>::infinity();
+  double z_max_m = std::numeric_limits<double>::infinity();
+  std::string pose = "0,0,0";
+  std::string algorithm = "fast";
+  std::string output_path;
+};
+
+double require(const std::optional<double>& value, const char* option, const std::string& shape) {
+  if (!value) throw std::invalid_argument(std::string(option) + " is required for --shape " + shape);
+  return *value;
+}
+
+Eigen::Isometry3d parse_pose(const std::string& text) {
+  double values[3];
+  if (roi::parse_csv_doubles(text, values) != 3 || !std::isfinite(values[0]) ||
+      !std::isfinite(values[1]) || !std::isfinite(values[2])) {
+    throw std::invalid_argument("--pose expects 'x_m,y_m,yaw_deg' with finite numbers, got '" + text + "'");
+  }
+  return roi::pose_from_xy_yaw(values[0], values[1], values[2] * M_PI / 180.0);
+}
+
+double spacing(const FilterOptions& o, double size_along_m) {
+  if (o.spacing_m.has_value() == o.spacing_ratio.has_value()) {
+    throw std::invalid_argument("give exactly one of --spacing and --spacing-ratio for --shape " + o.shape);
+  }
+  if (o.spacing_m) return *o.spacing_m;
+  if (!std::isfinite(*o.spacing_ratio) || *o.spacing_ratio <= 0.0) {
+    throw std::invalid_argument("--spacing-ratio must be finite and positive, got " +
+                                std::to_string(*o.spacing_ratio));
+  }
+  return roi::spacing_from_ratio(*o.spacing_ratio, size_along_m);
+}
+
+template <typename RoiSet>
+roi::FilterStats run_chain(const RoiSet& set, const std::string& algorithm,
+                           std::span<const roi::PointXYZd> points, std::vector<std::uint32_t>& kept) {
+  if (algorithm == "reference") return roi::reference_filter(set, points, kept);
+  roi::GridFilter<RoiSet> grid;
+  grid.build(set);
+  return grid.filter(points, kept);
+}
+
+void run_filter(const FilterOptions& o) {
+  // Read and validate everything first: on any error nothing is written.
+  const roi::Trajectory trajectory =
+      roi::parse_trajectory_csv(read_text_file(o.trajectory_path), o.trajectory_path);
+  std::vector<roi::PointXYZd> points =
+      eval::parse_points_csv(read_text_file(o.points_path), o.points_path);
+  const Eigen::Isometry3d global_from_sensor = parse_pose(o.pose);
+  roi::transform_points(global_from_sensor, points, points);
+  const roi::ZLimits z{o.z_min_m, o.z_max_m};
+  const double inf = std::numeric_limits<double>::infinity();
+
+  std::vector<std::uint32_t> kept;
+  roi::FilterStats stats;
+  std::vector<roi::Centre> centres;
+  if (o.shape == "circular") {
+    const double diameter = require(o.diameter_m, "--diameter", o.shape);
+    roi::place_centres(trajectory, 0.0, inf, spacing(o, diameter), centres);
+    stats = run_chain(roi::CircularRoiSet(diameter / 2.0, centres, z), o.algorithm, points, kept);
+  } else if (o.shape == "rectangular") {
+    const double height = require(o.height_m, "--height", o.shape);
+    const double width = require(o.width_m, "--width", o.shape);
+    roi::place_centres(trajectory, 0.0, inf, spacing(o, height), centres);
+    stats = run_chain(roi::RectangularRoiSet(height, width, centres, z), o.algorithm, points, kept);
+  } else if (o.shape == "corridor") {
+    const double width = require(o.width_m, "--width", o.shape);
+    stats = run_chain(roi::CorridorRoiSet(trajectory, 0.0, inf, width, z), o.algorithm, points, kept);
+  } else {  // cuboid: one box around the robot, in the robot (= sensor) frame
+    const double length = require(o.length_m, "--length", o.shape);
+    const double width = require(o.width_m, "--width", o.shape);
+    if (!(length > 0.0) || !(width > 0.0)) {
+      throw std::invalid_argument("cuboid --length and --width must be positive");
+    }
+    const roi::CuboidRoi cuboid(global_from_sensor, roi::centred_cuboid(length, width, o.z_min_m, o.z_max_m));
+    stats = roi::cuboid_filter(cuboid, std::span<const roi::PointXYZd>(points), kept);
+  }
+
+  std::string out;
+  out.reserve(kept.size() * 8);
+  for (const std::uint32_t i : kept) {
+    out += std::to_string(i);
+    out += '\n';
+  }
+  write_file_atomically(o.output_path, out);
+  std::fprintf(stderr, "trajroi filter: %zu points in, %zu kept, %zu non-finite dropped, %zu outside z limits\n",
+               stats.input, stats.kept, stats.non_finite, stats.outside_z);
+}
+
+}  // namespace
+
+void add_filter_command(CLI::App& app) {
+  auto o = std::make_shared<FilterOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "filter", "Keep the points of a CSV cloud inside a trajectory ROI; write their indices");
+  cmd->add_option("--trajectory", o->trajectory_path, "Trajectory CSV: 'x,y' per line (global frame, m)")
+      ->required();
+  cmd->add_option("--points", o->points_path, "Points CSV: 'x,y,z[,intensity]' per line (sensor frame, m)")
+      ->required();
+  cmd->add_option("--shape", o->shape, "ROI method")
+      ->required()
+      ->check(CLI::IsMember({"circular", "rectangular", "corridor", "cuboid"}));
+  cmd->add_option("--diameter", o->diameter_m, "Circle diameter 2r [m] (circular)");
+  cmd->add_option("--height", o->height_m, "Rectangle height a along the tangent [m] (rectangular)");
+  cmd->add_option("--width", o->width_m, "Rectangle width b / corridor width / cuboid width [m]");
+  cmd->add_option("--length", o->length_m, "Cuboid length along the robot's x axis [m] (cuboid)");
+  auto* spacing_opt = cmd->add_option("--spacing", o->spacing_m, "Distance d between centres [m]");
+  auto* ratio_opt = cmd->add_option("--spacing-ratio", o->spacing_ratio,
+                                    "d as a fraction of the diameter (circular) or height (rectangular): 0.25 = 25 %");
+  spacing_opt->excludes(ratio_opt);
+  cmd->add_option("--z-min", o->z_min_m, "Lowest z kept [m] (global frame; robot frame for cuboid)");
+  cmd->add_option("--z-max", o->z_max_m, "Highest z kept [m]");
+  cmd->add_option("--pose", o->pose, "Robot pose 'x_m,y_m,yaw_deg' (sensor frame = robot frame)")
+      ->capture_default_str();
+  cmd->add_option("--algorithm", o->algorithm, "Membership implementation")
+      ->check(CLI::IsMember({"reference", "fast"}))
+      ->capture_default_str();
+  cmd->add_option("--output-indices", o->output_path, "Write 0-based kept indices here, ascending")
+      ->required();
+  cmd->callback([o] { run_filter(*o); });
+}
+
+}  // namespace trajroi::cli

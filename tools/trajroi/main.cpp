@@ -1,0 +1,21 @@
+// trajroi: the command-line tool of the trajroi project (evaluation, filtering, dumps).
+#include <cstdio>
+#include <exception>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"trajroi — trajectory-based regions of interest for LiDAR point clouds"};
+  app.require_subcommand(1);
+  trajroi::cli::add_eval_commands(app);
+  trajroi::cli::add_filter_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "trajroi: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
