@@ -110,7 +110,7 @@ Trajectory parse_trajectory_csv(std::string_view text, std::string_view source_n
     const std::string_view content = strip_comment_and_space(line);
     if (content.empty()) return;
     double values[2];
-    if (!parse_csv_doubles(content, values)) {
+    if (parse_csv_doubles(content, values) != 2) {
       throw TrajectoryError(TrajectoryErrc::kParse,
                             std::string(source_name) + ":" + std::to_string(line_number) +
                                 ": expected 'x,y' (metres), got '" + std::string(content) + "'");

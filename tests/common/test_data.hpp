@@ -1,0 +1,36 @@
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace trajroi::test {
+
+// The folder of third-party captures, from TRAJROI_DATA_DIR (set by CMake on every test).
+inline std::filesystem::path data_dir() {
+  const char* dir = std::getenv("TRAJROI_DATA_DIR");
+  return dir != nullptr ? std::filesystem::path(dir) : std::filesystem::path();
+}
+
+inline bool running_in_ci() {
+  const char* ci = std::getenv("CI");
+  return ci != nullptr && std::string_view(ci) == "true";
+}
+
+}  // namespace trajroi::test
+
+// Resolves `relative` inside the data folder into `path_var`. When the file is missing the
+// test is skipped with the reason, except under CI (CI=true), where a missing capture fails.
+#define TRAJROI_REQUIRE_DATA(path_var, relative)                                                  \
+  const std::filesystem::path path_var = ::trajroi::test::data_dir() / (relative);              \
+  if (!std::filesystem::exists(path_var)) {                                                       \
+    if (::trajroi::test::running_in_ci()) {                                                       \
+      FAIL() << "test data missing under CI: " << path_var << " (TRAJROI_DATA_DIR='"              \
+             << ::trajroi::test::data_dir().string() << "')";                                    \
+    }                                                                                             \
+    GTEST_SKIP() << "test data not found: " << path_var                                          \
+                 << " (set TRAJROI_DATA_DIR to the shared data folder)";                          \
+  }

@@ -1,0 +1,129 @@
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "trajroi/roi/grid_filter.hpp"
+#include "trajroi/roi/point.hpp"
+#include "trajroi/roi/reference_filter.hpp"
+#include "trajroi/roi/shapes.hpp"
+
+namespace trajroi::roi {
+namespace {
+
+using V = Eigen::Vector2d;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+
+// The same checks for every ROI method (TEST_P over shapes).
+enum class Kind { kCircular, kRectangular, kCorridor };
+
+class FilterBehaviour : public ::testing::TestWithParam<Kind> {
+ protected:
+  Trajectory trajectory_{{V(0, 0), V(20, 0)}};
+
+  // Runs both algorithms, checks they agree, returns the kept indices.
+  template <typename Point>
+  std::vector<std::uint32_t> run(std::span<const Point> points, ZLimits z, FilterStats* stats) {
+    std::vector<Centre> centres;
+    place_centres(trajectory_, 0.0, kInf, 1.0, centres);
+    std::vector<std::uint32_t> ref;
+    std::vector<std::uint32_t> fast;
+    FilterStats ref_stats;
+    FilterStats fast_stats;
+    auto both = [&](const auto& set) {
+      ref_stats = reference_filter(set, points, ref);
+      GridFilter<std::decay_t<decltype(set)>> grid;
+      grid.build(set);
+      fast_stats = grid.filter(points, fast);
+    };
+    switch (GetParam()) {
+      case Kind::kCircular: both(CircularRoiSet(2.0, centres, z)); break;
+      case Kind::kRectangular: both(RectangularRoiSet(2.0, 4.0, centres, z)); break;
+      case Kind::kCorridor: both(CorridorRoiSet(trajectory_, 0.0, kInf, 4.0, z)); break;
+    }
+    EXPECT_EQ(ref, fast);
+    EXPECT_EQ(ref_stats.kept, fast_stats.kept);
+    EXPECT_EQ(ref_stats.non_finite, fast_stats.non_finite);
+    EXPECT_EQ(ref_stats.outside_z, fast_stats.outside_z);
+    *stats = fast_stats;
+    return fast;
+  }
+};
+
+TEST_P(FilterBehaviour, EmptyCloud) {
+  FilterStats stats;
+  const std::vector<PointXYZI> none;
+  EXPECT_TRUE(run(std::span<const PointXYZI>(none), {}, &stats).empty());
+  EXPECT_EQ(stats.input, 0u);
+}
+
+TEST_P(FilterBehaviour, NonFinitePointsAreNeverKeptAndAreCounted) {
+  const float nanf = std::numeric_limits<float>::quiet_NaN();
+  const float inff = std::numeric_limits<float>::infinity();
+  const std::vector<PointXYZI> points{{5, 0, 0, 1},    {nanf, 0, 0, 1}, {5, nanf, 0, 1},
+                                      {5, 0, nanf, 1}, {inff, 0, 0, 1}, {5, -inff, 0, 1},
+                                      {5, 0, inff, 1}, {6, 0.5f, 0, 1}, {50, 0, 0, 1}};
+  FilterStats stats;
+  const auto kept = run(std::span<const PointXYZI>(points), {}, &stats);
+  EXPECT_EQ(kept, (std::vector<std::uint32_t>{0, 7}));
+  EXPECT_EQ(stats.non_finite, 6u);
+  EXPECT_EQ(stats.input, 9u);
+}
+
+TEST_P(FilterBehaviour, ZLimitsAreInclusiveAndCounted) {
+  const std::vector<PointXYZd> points{{5, 0, -1}, {5, 0, -1.0001}, {5, 0, 2}, {5, 0, 2.0001}, {5, 0, 0}};
+  FilterStats stats;
+  const auto kept = run(std::span<const PointXYZd>(points), ZLimits{-1.0, 2.0}, &stats);
+  EXPECT_EQ(kept, (std::vector<std::uint32_t>{0, 2, 4}));
+  EXPECT_EQ(stats.outside_z, 2u);
+}
+
+TEST_P(FilterBehaviour, KeepsAlongTheChainOnly) {
+  const std::vector<PointXYZd> points{{0, 0, 0}, {10, 1.5, 0}, {20, -1.5, 0}, {10, 2.5, 0}, {-3, 0, 0}, {24, 0, 0}};
+  FilterStats stats;
+  const auto kept = run(std::span<const PointXYZd>(points), {}, &stats);
+  EXPECT_EQ(kept, (std::vector<std::uint32_t>{0, 1, 2}));
+}
+
+INSTANTIATE_TEST_SUITE_P(AllShapes, FilterBehaviour,
+                         ::testing::Values(Kind::kCircular, Kind::kRectangular, Kind::kCorridor),
+                         [](const ::testing::TestParamInfo<Kind>& param_info) {
+                           switch (param_info.param) {
+                             case Kind::kCircular: return std::string("circular");
+                             case Kind::kRectangular: return std::string("rectangular");
+                             case Kind::kCorridor: return std::string("corridor");
+                           }
+                           return std::string("unknown");
+                         });
+
+TEST(GridFilter, EmptyChainKeepsNothing) {
+  const CircularRoiSet set(1.0, std::vector<Centre>{});
+  GridFilter<CircularRoiSet> grid;
+  grid.build(set);
+  const std::vector<PointXYZd> points{{0, 0, 0}};
+  std::vector<std::uint32_t> kept{7};
+  const FilterStats stats = grid.filter(std::span<const PointXYZd>(points), kept);
+  EXPECT_TRUE(kept.empty());
+  EXPECT_EQ(stats.kept, 0u);
+}
+
+TEST(GridFilter, HugeAreaStaysWithinTheCellCeiling) {
+  // 10 km diagonal chain of 1 m circles: the grid coarsens instead of growing without bound.
+  const Trajectory t({V(0, 0), V(7071, 7071)});
+  std::vector<Centre> centres;
+  place_centres(t, 0.0, kInf, 1.0, centres);
+  const CircularRoiSet set(1.0, centres);
+  GridFilter<CircularRoiSet> grid;
+  grid.build(set);
+  EXPECT_LE(grid.cell_count(), GridFilter<CircularRoiSet>::kMaxCells);
+  const std::vector<PointXYZd> points{{5000, 5000, 0}, {5000, 5001.5, 0}, {5000.5, 5000.5, 0}};
+  std::vector<std::uint32_t> fast;
+  std::vector<std::uint32_t> ref;
+  grid.filter(std::span<const PointXYZd>(points), fast);
+  reference_filter(set, std::span<const PointXYZd>(points), ref);
+  EXPECT_EQ(fast, ref);
+  EXPECT_EQ(fast, (std::vector<std::uint32_t>{0, 2}));
+}
+
+}  // namespace
+}  // namespace trajroi::roi

@@ -1,0 +1,49 @@
+#include "trajroi/roi/transform.hpp"
+
+#include <gtest/gtest.h>
+
+#include <numbers>
+
+namespace trajroi::roi {
+namespace {
+
+TEST(Transform, ComposesGlobalFromRobotAndRobotFromSensor) {
+  // Robot at (10, 5) facing +y; sensor 1 m ahead of the robot's origin, 2 m up.
+  const Eigen::Isometry3d global_from_robot = pose_from_xy_yaw(10, 5, std::numbers::pi / 2);
+  const Eigen::Isometry3d robot_from_sensor = pose_from_xy_yaw(1, 0, 0, 2);
+  const Eigen::Isometry3d global_from_sensor = global_from_robot * robot_from_sensor;
+  std::vector<PointXYZI> in{{1, 0, 0, 7}, {0, 1, -2, 8}};
+  std::vector<PointXYZI> out(2);
+  transform_points(global_from_sensor, in, out);
+  // 1 m ahead of the sensor: sensor at (10, 6, 2), ahead = +y → (10, 7, 2)
+  EXPECT_NEAR(out[0].x, 10.0f, 1e-5f);
+  EXPECT_NEAR(out[0].y, 7.0f, 1e-5f);
+  EXPECT_NEAR(out[0].z, 2.0f, 1e-5f);
+  EXPECT_EQ(out[0].intensity, 7.0f);
+  // 1 m to the sensor's left (+y) = −x in the global frame, 2 m down → ground
+  EXPECT_NEAR(out[1].x, 9.0f, 1e-5f);
+  EXPECT_NEAR(out[1].y, 6.0f, 1e-5f);
+  EXPECT_NEAR(out[1].z, 0.0f, 1e-5f);
+  EXPECT_EQ(out[1].intensity, 8.0f);
+}
+
+TEST(Transform, InPlaceEqualsOutOfPlace) {
+  const Eigen::Isometry3d pose = pose_from_xy_yaw(-3.5, 2.25, 0.7, 0.4);
+  std::vector<PointXYZd> a{{1.5, -2.0, 0.25}, {100.0, 3.0, -1.0}};
+  std::vector<PointXYZd> b(a.size());
+  transform_points(pose, a, b);
+  transform_points(pose, a, a);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].x, b[i].x);
+    EXPECT_EQ(a[i].y, b[i].y);
+    EXPECT_EQ(a[i].z, b[i].z);
+  }
+  // and against Eigen's own product
+  const Eigen::Vector3d expected = pose * Eigen::Vector3d(1.5, -2.0, 0.25);
+  EXPECT_NEAR(b[0].x, expected.x(), 1e-12);
+  EXPECT_NEAR(b[0].y, expected.y(), 1e-12);
+  EXPECT_NEAR(b[0].z, expected.z(), 1e-12);
+}
+
+}  // namespace
+}  // namespace trajroi::roi

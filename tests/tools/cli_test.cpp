@@ -1,0 +1,154 @@
+// The `trajroi` binary run as a user runs it: real files, real exit codes.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandResult {
+  int exit_code;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("trajroi_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path write(const std::string& name, const std::string& content) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << content;
+    return p;
+  }
+
+  CommandResult run(const std::string& args) {
+    const fs::path out = dir_ / "stdout.txt";
+    const fs::path err = dir_ / "stderr.txt";
+    const std::string command = std::string(TRAJROI_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
+    const int status = std::system(command.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(Cli, FilterAppliesThePoseAndKeepsTheRightIndices) {
+  const fs::path traj = write("t.csv", "# straight 10 m\n0,0\n10,0\n");
+  // Robot at (5, 0) facing +y (yaw 90°): sensor (2,0) → global (5,2); (0,−4) → (9,0);
+  // (0,9) → (−4,0); (0,−8) → (13,0), exactly r = 3 m past the last centre: inside,
+  // the test is inclusive; (7,0) → (5,7).
+  const fs::path pts = write("p.csv", "2,0,0\n0,-4,0,10\n0,9,0\n0,-8,0\n7,0,0\nnan,0,0\n");
+  const fs::path out = dir_ / "kept.txt";
+  for (const char* algorithm : {"reference", "fast"}) {
+    const CommandResult r = run("filter --trajectory " + traj.string() + " --points " + pts.string() +
+                      " --shape circular --diameter 6 --spacing 1 --pose 5,0,90 --algorithm " + algorithm +
+                      " --output-indices " + out.string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(slurp(out), "0\n1\n3\n") << algorithm;
+    EXPECT_NE(r.err.find("1 non-finite"), std::string::npos) << r.err;
+  }
+}
+
+TEST_F(Cli, FilterRectangleCorridorAndCuboid) {
+  const fs::path traj = write("t.csv", "0,0\n10,0\n10,10\n");
+  const fs::path pts = write("p.csv", "5,0.9,0\n5,1.1,0\n11.2,5,0\n-0.4,0,0\n10.9,10.9,0\n");
+  const fs::path out = dir_ / "kept.txt";
+  CommandResult r = run("filter --trajectory " + traj.string() + " --points " + pts.string() +
+              " --shape rectangular --height 1 --width 2 --spacing-ratio 0.5 --output-indices " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(slurp(out), "0\n3\n");  // (11.2,5) is 1.2 m across, (10.9,10.9) 0.9 m past the end (a/2 = 0.5)
+  r = run("filter --trajectory " + traj.string() + " --points " + pts.string() +
+          " --shape corridor --width 2.6 --output-indices " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(slurp(out), "0\n1\n2\n3\n4\n");  // (10.9,10.9): 1.27 m from the end (round cap, 1.3)
+  r = run("filter --trajectory " + traj.string() + " --points " + pts.string() +
+          " --shape cuboid --length 12 --width 2 --z-min -1 --z-max 1 --output-indices " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(slurp(out), "0\n3\n");
+}
+
+TEST_F(Cli, MalformedPointsNameFileAndLineAndWriteNothing) {
+  const fs::path traj = write("t.csv", "0,0\n10,0\n");
+  const fs::path pts = write("p.csv", "1,0,0\n2,0,0\n3,zero,0\n");
+  const fs::path out = dir_ / "kept.txt";
+  const CommandResult r = run("filter --trajectory " + traj.string() + " --points " + pts.string() +
+                    " --shape circular --diameter 6 --spacing 1 --output-indices " + out.string());
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find(pts.string() + ":3:"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(Cli, BadTrajectoryAndBadSizesAreClearErrors) {
+  const fs::path pts = write("p.csv", "1,0,0\n");
+  const fs::path out = dir_ / "kept.txt";
+  struct Case {
+    std::string traj;
+    std::string args;
+    std::string expected;
+  };
+  for (const Case& c : {Case{"0,0\n0,0\n", "--shape circular --diameter 6 --spacing 1", "at least two distinct"},
+                        Case{"0,0\n1,x\n", "--shape circular --diameter 6 --spacing 1", "t.csv:2:"},
+                        Case{"0,0\n9,0\n", "--shape circular --diameter -6 --spacing 1", "radius must be finite and positive"},
+                        Case{"0,0\n9,0\n", "--shape circular --diameter 6 --spacing 0", "spacing must be finite and positive"},
+                        Case{"0,0\n9,0\n", "--shape rectangular --height 0 --width 2 --spacing 1", "height a must be"},
+                        Case{"0,0\n9,0\n", "--shape rectangular --height 1 --width 2", "exactly one of --spacing"},
+                        Case{"0,0\n9,0\n", "--shape circular --spacing 1", "--diameter is required"},
+                        Case{"0,0\n9,0\n", "--shape circular --diameter 6 --spacing 1 --pose 1,2", "--pose expects"}}) {
+    const fs::path traj = write("t.csv", c.traj);
+    const CommandResult r = run("filter --trajectory " + traj.string() + " --points " + pts.string() + " " + c.args +
+                      " --output-indices " + out.string());
+    EXPECT_NE(r.exit_code, 0) << c.args;
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << c.args << " → " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+  }
+}
+
+TEST_F(Cli, EvalArtificialCsvMatchesThePaper) {
+  const CommandResult r = run("eval artificial --format csv --data straight --shape circular --reps 2");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::istringstream lines(r.out);
+  std::string line;
+  std::getline(lines, line);
+  EXPECT_EQ(line,
+            "data,shape,ratio_pct,num_roi,tp,fp,fn,tn,precision,recall,accuracy,ref_min_ms,ref_max_ms,"
+            "ref_avg_ms,fast_min_ms,fast_max_ms,fast_avg_ms");
+  std::getline(lines, line);
+  EXPECT_EQ(line.rfind("straight,circular,150,10,6234,0,6197,8020,1.000000,0.501488,0.696983,", 0), 0u) << line;
+  int rows = 1;
+  while (std::getline(lines, line)) ++rows;
+  EXPECT_EQ(rows, 7);
+}
+
+TEST_F(Cli, EvalArtificialWritesSvgPictures) {
+  const CommandResult r = run("eval artificial --data curved --shape rectangular --reps 1 --svg " + (dir_ / "svg").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string svg = slurp(dir_ / "svg" / "curved_rectangular_010.svg");
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  EXPECT_NE(svg.find("272 ROIs"), std::string::npos);
+  EXPECT_NE(svg.find("<polygon"), std::string::npos);
+  EXPECT_NE(svg.find("</svg>"), std::string::npos);
+}
+
+}  // namespace
