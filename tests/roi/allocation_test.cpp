@@ -17,6 +17,10 @@ namespace {
 std::atomic<std::size_t> g_allocations{0};
 }
 
+// Replacing the global allocation functions with malloc/free is what the standard allows;
+// GCC cannot see that the pair matches.
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+
 void* operator new(std::size_t size) {
   g_allocations.fetch_add(1, std::memory_order_relaxed);
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
@@ -36,7 +40,7 @@ TEST(Allocation, WarmFilterCallsAllocateNothing) {
   }
   std::vector<PointXYZI> global(points.size());
   std::vector<Centre> centres;
-  std::vector<std::uint32_t> kept;
+  IndexVector kept;
   CircularRoiSet circles(3.0, std::vector<Centre>{});
   RectangularRoiSet rects(3.0, 6.0, std::vector<Centre>{});
   GridFilter<CircularRoiSet> circle_grid;

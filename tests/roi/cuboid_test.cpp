@@ -25,9 +25,9 @@ TEST(Cuboid, OrientedWithTheRobot) {
 TEST(Cuboid, FilterCountsNonFinite) {
   const CuboidRoi box(Eigen::Isometry3d::Identity(), centred_cuboid(10, 2, -1, 1));
   const std::vector<PointXYZd> points{{0, 0, 0}, {std::nan(""), 0, 0}, {6, 0, 0}, {-4, 0.9, 0.9}};
-  std::vector<std::uint32_t> kept;
+  IndexVector kept;
   const FilterStats stats = cuboid_filter(box, std::span<const PointXYZd>(points), kept);
-  EXPECT_EQ(kept, (std::vector<std::uint32_t>{0, 3}));
+  EXPECT_EQ(kept, (IndexVector{0, 3}));
   EXPECT_EQ(stats.non_finite, 1u);
 }
 

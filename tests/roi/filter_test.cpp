@@ -23,17 +23,24 @@ class FilterBehaviour : public ::testing::TestWithParam<Kind> {
 
   // Runs both algorithms, checks they agree, returns the kept indices.
   template <typename Point>
-  std::vector<std::uint32_t> run(std::span<const Point> points, ZLimits z, FilterStats* stats) {
+  IndexVector run(std::span<const Point> points, ZLimits z, FilterStats* stats) {
     std::vector<Centre> centres;
     place_centres(trajectory_, 0.0, kInf, 1.0, centres);
-    std::vector<std::uint32_t> ref;
-    std::vector<std::uint32_t> fast;
+    IndexVector ref;
+    IndexVector fast;
     FilterStats ref_stats;
     FilterStats fast_stats;
     auto both = [&](const auto& set) {
       ref_stats = reference_filter(set, points, ref);
       GridFilter<std::decay_t<decltype(set)>> grid;
       grid.build(set);
+      for (const SimdPath path : {SimdPath::kAvx2, SimdPath::kSse2, SimdPath::kScalar}) {
+        IndexVector other;
+        const FilterStats other_stats = grid.filter(points, other, path);
+        EXPECT_EQ(other, ref) << "path " << static_cast<int>(path);
+        EXPECT_EQ(other_stats.non_finite, ref_stats.non_finite) << "path " << static_cast<int>(path);
+        EXPECT_EQ(other_stats.outside_z, ref_stats.outside_z) << "path " << static_cast<int>(path);
+      }
       fast_stats = grid.filter(points, fast);
     };
     switch (GetParam()) {
@@ -65,7 +72,7 @@ TEST_P(FilterBehaviour, NonFinitePointsAreNeverKeptAndAreCounted) {
                                       {5, 0, inff, 1}, {6, 0.5f, 0, 1}, {50, 0, 0, 1}};
   FilterStats stats;
   const auto kept = run(std::span<const PointXYZI>(points), {}, &stats);
-  EXPECT_EQ(kept, (std::vector<std::uint32_t>{0, 7}));
+  EXPECT_EQ(kept, (IndexVector{0, 7}));
   EXPECT_EQ(stats.non_finite, 6u);
   EXPECT_EQ(stats.input, 9u);
 }
@@ -74,7 +81,7 @@ TEST_P(FilterBehaviour, ZLimitsAreInclusiveAndCounted) {
   const std::vector<PointXYZd> points{{5, 0, -1}, {5, 0, -1.0001}, {5, 0, 2}, {5, 0, 2.0001}, {5, 0, 0}};
   FilterStats stats;
   const auto kept = run(std::span<const PointXYZd>(points), ZLimits{-1.0, 2.0}, &stats);
-  EXPECT_EQ(kept, (std::vector<std::uint32_t>{0, 2, 4}));
+  EXPECT_EQ(kept, (IndexVector{0, 2, 4}));
   EXPECT_EQ(stats.outside_z, 2u);
 }
 
@@ -82,7 +89,7 @@ TEST_P(FilterBehaviour, KeepsAlongTheChainOnly) {
   const std::vector<PointXYZd> points{{0, 0, 0}, {10, 1.5, 0}, {20, -1.5, 0}, {10, 2.5, 0}, {-3, 0, 0}, {24, 0, 0}};
   FilterStats stats;
   const auto kept = run(std::span<const PointXYZd>(points), {}, &stats);
-  EXPECT_EQ(kept, (std::vector<std::uint32_t>{0, 1, 2}));
+  EXPECT_EQ(kept, (IndexVector{0, 1, 2}));
 }
 
 INSTANTIATE_TEST_SUITE_P(AllShapes, FilterBehaviour,
@@ -101,7 +108,7 @@ TEST(GridFilter, EmptyChainKeepsNothing) {
   GridFilter<CircularRoiSet> grid;
   grid.build(set);
   const std::vector<PointXYZd> points{{0, 0, 0}};
-  std::vector<std::uint32_t> kept{7};
+  IndexVector kept{7};
   const FilterStats stats = grid.filter(std::span<const PointXYZd>(points), kept);
   EXPECT_TRUE(kept.empty());
   EXPECT_EQ(stats.kept, 0u);
@@ -117,12 +124,12 @@ TEST(GridFilter, HugeAreaStaysWithinTheCellCeiling) {
   grid.build(set);
   EXPECT_LE(grid.cell_count(), GridFilter<CircularRoiSet>::kMaxCells);
   const std::vector<PointXYZd> points{{5000, 5000, 0}, {5000, 5001.5, 0}, {5000.5, 5000.5, 0}};
-  std::vector<std::uint32_t> fast;
-  std::vector<std::uint32_t> ref;
+  IndexVector fast;
+  IndexVector ref;
   grid.filter(std::span<const PointXYZd>(points), fast);
   reference_filter(set, std::span<const PointXYZd>(points), ref);
   EXPECT_EQ(fast, ref);
-  EXPECT_EQ(fast, (std::vector<std::uint32_t>{0, 2}));
+  EXPECT_EQ(fast, (IndexVector{0, 2}));
 }
 
 }  // namespace

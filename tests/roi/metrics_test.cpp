@@ -1,4 +1,5 @@
 #include "trajroi/roi/metrics.hpp"
+#include "trajroi/roi/filter_stats.hpp"
 #include "trajroi/roi/point.hpp"
 
 #include <gtest/gtest.h>
@@ -8,7 +9,7 @@ namespace {
 
 TEST(Metrics, CountsAndEquationThree) {
   const std::vector<std::uint8_t> truth{1, 1, 1, 0, 0, 1, 0};
-  const std::vector<std::uint32_t> kept{0, 1, 3};
+  const IndexVector kept{0, 1, 3};
   const Confusion c = confusion(kept, truth);
   EXPECT_EQ(c.tp, 2u);
   EXPECT_EQ(c.fp, 1u);
@@ -40,13 +41,13 @@ TEST(Metrics, ZeroDenominatorsAreOne) {
 
 TEST(Metrics, RejectsIndexPastLabels) {
   const std::vector<std::uint8_t> truth{1, 0};
-  const std::vector<std::uint32_t> kept{2};
+  const IndexVector kept{2};
   EXPECT_THROW((void)confusion(kept, truth), std::out_of_range);
 }
 
 TEST(Metrics, Compact) {
   const std::vector<PointXYZI> points{{1, 0, 0, 0}, {2, 0, 0, 0}, {3, 0, 0, 0}};
-  const std::vector<std::uint32_t> kept{0, 2};
+  const IndexVector kept{0, 2};
   std::vector<PointXYZI> out;
   compact(std::span<const PointXYZI>(points), kept, out);
   ASSERT_EQ(out.size(), 2u);

@@ -65,7 +65,7 @@ double spacing(const FilterOptions& o, double size_along_m) {
 
 template <typename RoiSet>
 roi::FilterStats run_chain(const RoiSet& set, const std::string& algorithm,
-                           std::span<const roi::PointXYZd> points, std::vector<std::uint32_t>& kept) {
+                           std::span<const roi::PointXYZd> points, roi::IndexVector& kept) {
   if (algorithm == "reference") return roi::reference_filter(set, points, kept);
   roi::GridFilter<RoiSet> grid;
   grid.build(set);
@@ -83,7 +83,7 @@ void run_filter(const FilterOptions& o) {
   const roi::ZLimits z{o.z_min_m, o.z_max_m};
   const double inf = std::numeric_limits<double>::infinity();
 
-  std::vector<std::uint32_t> kept;
+  roi::IndexVector kept;
   roi::FilterStats stats;
   std::vector<roi::Centre> centres;
   if (o.shape == "circular") {

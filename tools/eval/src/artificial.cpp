@@ -76,7 +76,7 @@ template <typename RoiSet>
 ArtificialRow run_with(const ArtificialScene& scene, ArtificialRow row, int reps,
                        auto make_set) {
   const std::span<const roi::PointXYZd> points(scene.points);
-  std::vector<std::uint32_t> reference_kept;
+  roi::IndexVector reference_kept;
   reference_kept.reserve(points.size());
   row.kept.reserve(points.size());
   row.reference = time_repeated(reps, [&] {

@@ -55,7 +55,7 @@ class CuboidRoi {
 // never kept. `kept` is cleared and gets ascending indices.
 template <typename Point>
 FilterStats cuboid_filter(const CuboidRoi& cuboid, std::span<const Point> points,
-                          std::vector<std::uint32_t>& kept) {
+                          IndexVector& kept) {
   struct NoZLimit {
     [[nodiscard]] bool contains(double) const noexcept { return true; }
   };
@@ -68,7 +68,7 @@ FilterStats cuboid_filter(const CuboidRoi& cuboid, std::span<const Point> points
     const double z = points[i].z;
     const Precheck pre = precheck(NoZLimit{}, x, y, z);
     if (pre != Precheck::kPass) {
-      count(stats, pre);
+      count_rejection(stats, pre);
       continue;
     }
     if (cuboid.contains(x, y, z)) kept.push_back(static_cast<std::uint32_t>(i));

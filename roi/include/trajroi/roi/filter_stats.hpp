@@ -3,8 +3,36 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <new>
+#include <type_traits>
+#include <vector>
 
 namespace trajroi::roi {
+
+// An allocator whose value-less construct() default-initialises: resize() on a vector of
+// integers then leaves new elements unwritten instead of zeroing them. The fast filter sizes
+// its output for every point up front and writes each index unconditionally, so a zeroing
+// resize would cost a memset of the whole output per call.
+template <typename T>
+struct DefaultInitAllocator : std::allocator<T> {
+  template <typename U>
+  struct rebind {
+    using other = DefaultInitAllocator<U>;
+  };
+  using std::allocator<T>::allocator;
+  template <typename U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+// Indices of kept points, ascending. A std::vector in every respect but resize().
+using IndexVector = std::vector<std::uint32_t, DefaultInitAllocator<std::uint32_t>>;
 
 // What one filter call saw. Every input point is in exactly one of: kept, non_finite,
 // outside_z, or rejected by the XY test (input − the other three).
@@ -27,7 +55,7 @@ template <typename ZLimitsT>
   return Precheck::kPass;
 }
 
-inline void count(FilterStats& stats, Precheck result) noexcept {
+inline void count_rejection(FilterStats& stats, Precheck result) noexcept {
   if (result == Precheck::kNonFinite) ++stats.non_finite;
   if (result == Precheck::kOutsideZ) ++stats.outside_z;
 }

@@ -15,7 +15,7 @@ namespace trajroi::roi {
 // receives the indices of the kept points in ascending order; its capacity is reused.
 template <typename RoiSet, typename Point>
 FilterStats reference_filter(const RoiSet& rois, std::span<const Point> points,
-                             std::vector<std::uint32_t>& kept) {
+                             IndexVector& kept) {
   FilterStats stats;
   stats.input = points.size();
   kept.clear();
@@ -25,7 +25,7 @@ FilterStats reference_filter(const RoiSet& rois, std::span<const Point> points,
     const double y = points[i].y;
     const Precheck pre = precheck(rois.z_limits(), x, y, points[i].z);
     if (pre != Precheck::kPass) {
-      count(stats, pre);
+      count_rejection(stats, pre);
       continue;
     }
     for (std::size_t j = 0; j < m; ++j) {

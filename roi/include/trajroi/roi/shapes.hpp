@@ -65,7 +65,7 @@ class CircularRoiSet {
   [[nodiscard]] CellRelation relation(std::size_t j, const Box& cell,
                                       double tolerance_m) const noexcept;
   // The grid cell size that keeps the boundary band thin without too many cells.
-  [[nodiscard]] double cell_size_hint_m() const noexcept { return radius_m_ / 4.0; }
+  [[nodiscard]] double cell_size_hint_m() const noexcept { return radius_m_ / 8.0; }
 
  private:
   double radius_m_;
@@ -118,7 +118,7 @@ class RectangularRoiSet {
   [[nodiscard]] CellRelation relation(std::size_t j, const Box& cell,
                                       double tolerance_m) const noexcept;
   [[nodiscard]] double cell_size_hint_m() const noexcept {
-    return std::min(height_m_, width_m_) / 4.0;
+    return std::min(height_m_, width_m_) / 8.0;
   }
 
  private:

@@ -7,6 +7,7 @@
 
 #include "trajroi/eval/timing.hpp"
 #include "trajroi/roi/centres.hpp"
+#include "trajroi/roi/filter_stats.hpp"
 #include "trajroi/roi/metrics.hpp"
 #include "trajroi/roi/point.hpp"
 #include "trajroi/roi/trajectory.hpp"
@@ -47,7 +48,7 @@ struct ArtificialRow {
   double spacing_m;
   std::vector<roi::Centre> centres;
   roi::Confusion confusion;
-  std::vector<std::uint32_t> kept;  // the fast filter's output
+  roi::IndexVector kept;  // the fast filter's output
   bool fast_equals_reference;       // kept indices identical, point for point
   TimingStats reference;
   TimingStats fast;
