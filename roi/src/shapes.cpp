@@ -35,19 +35,20 @@ double box_far_distance2(const Box& b, double px, double py) noexcept {
   return dx * dx + dy * dy;
 }
 
-// Relation of a cell to a region {p : lo ≤ f(p) ≤ hi} ∩ … given the values of the linear
-// functions at the cell's corners (a linear function's extremes over a box are at corners).
+// Range of the linear function f(p) = e·(p − o) over a box: its value at the box's centre
+// plus or minus its largest change towards a corner.
 struct SlabRange {
   double min;
   double max;
 };
 
 SlabRange slab_range(double ox, double oy, double ex, double ey, const Box& cell) noexcept {
-  const std::array<double, 4> values{
-      ex * (cell.x_min - ox) + ey * (cell.y_min - oy), ex * (cell.x_max - ox) + ey * (cell.y_min - oy),
-      ex * (cell.x_min - ox) + ey * (cell.y_max - oy), ex * (cell.x_max - ox) + ey * (cell.y_max - oy)};
-  return {*std::min_element(values.begin(), values.end()),
-          *std::max_element(values.begin(), values.end())};
+  const double mx = 0.5 * (cell.x_min + cell.x_max);
+  const double my = 0.5 * (cell.y_min + cell.y_max);
+  const double centre = ex * (mx - ox) + ey * (my - oy);
+  const double reach = std::abs(ex) * 0.5 * (cell.x_max - cell.x_min) +
+                       std::abs(ey) * 0.5 * (cell.y_max - cell.y_min);
+  return {centre - reach, centre + reach};
 }
 
 }  // namespace
@@ -106,6 +107,8 @@ RectGeometry make_rect_geometry(double cx, double cy, double theta_rad, double h
   g.bcy = ccy - by;
   g.ab2 = g.abx * g.abx + g.aby * g.aby;
   g.bc2 = g.bcx * g.bcx + g.bcy * g.bcy;
+  g.ab = std::sqrt(g.ab2);
+  g.bc = std::sqrt(g.bc2);
   return g;
 }
 
@@ -140,8 +143,9 @@ CellRelation RectangularRoiSet::relation(std::size_t j, const Box& cell,
   const RectGeometry& g = rects_[j];
   // f1 = AB·(p − A) ∈ [0, ‖AB‖²] and f2 = BC·(p − B) ∈ [0, ‖BC‖²]; f / ‖e‖ is a distance, so
   // a margin of tolerance_m metres is tolerance_m · ‖e‖ in f units.
-  const double tol1 = tolerance_m * std::sqrt(g.ab2);
-  const double tol2 = tolerance_m * std::sqrt(g.bc2);
+  // The margin also absorbs the rounding of the centre-based range (a few ulps of f).
+  const double tol1 = tolerance_m * g.ab;
+  const double tol2 = tolerance_m * g.bc;
   const SlabRange f1 = slab_range(g.ax, g.ay, g.abx, g.aby, cell);
   const SlabRange f2 = slab_range(g.bx, g.by, g.bcx, g.bcy, cell);
   if (f1.max < -tol1 || f1.min > g.ab2 + tol1 || f2.max < -tol2 || f2.min > g.bc2 + tol2) {

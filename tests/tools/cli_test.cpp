@@ -146,7 +146,7 @@ TEST_F(Cli, EvalArtificialWritesSvgPictures) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string svg = slurp(dir_ / "svg" / "curved_rectangular_010.svg");
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
-  EXPECT_NE(svg.find("272 ROIs"), std::string::npos);
+  EXPECT_NE(svg.find("272 ROIs — TP 11803, FP 49"), std::string::npos);
   EXPECT_NE(svg.find("<polygon"), std::string::npos);
   EXPECT_NE(svg.find("</svg>"), std::string::npos);
 }

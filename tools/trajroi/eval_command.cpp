@@ -36,8 +36,8 @@ std::vector<eval::RoiShape> selected_shapes(const std::string& name) {
 void write_row_svg(const std::filesystem::path& dir, const eval::ArtificialScene& scene,
                    const eval::ArtificialRow& row) {
   const bool straight = scene.data == eval::ArtificialData::kStraight;
-  char title[160];
-  std::snprintf(title, sizeof title, "%s data, %s ROI, spacing %d %% (%.2f m): %zu ROIs, TP %llu FP %llu FN %llu TN %llu",
+  char title[200];
+  std::snprintf(title, sizeof title, "%s data, %s ROI, spacing %d %% (%.2f m)\n%zu ROIs — TP %llu, FP %llu, FN %llu, TN %llu",
                 std::string(to_string(row.data)).c_str(), std::string(to_string(row.shape)).c_str(),
                 row.ratio_pct, row.spacing_m, row.centres.size(),
                 static_cast<unsigned long long>(row.confusion.tp),
@@ -67,7 +67,7 @@ void write_row_svg(const std::filesystem::path& dir, const eval::ArtificialScene
     }
   }
   canvas.polyline(scene.trajectory.waypoints(), eval::kColourTrajectory);
-  canvas.legend(eval::kColourTp, "TP: kept, inside the ground truth");
+  canvas.legend(eval::kColourTp, "TP: kept, in the ground-truth corridor");
   canvas.legend(eval::kColourFp, "FP: kept, outside it");
   canvas.legend(eval::kColourFn, "FN: missed");
   canvas.legend(eval::kColourTn, "TN: dropped, outside it");

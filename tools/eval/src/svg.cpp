@@ -68,13 +68,15 @@ void SvgCanvas::polyline(std::span<const Eigen::Vector2d> points, std::string_vi
 }
 
 void SvgCanvas::legend(std::string_view colour, std::string_view label) {
-  const double y = kHeader + kMargin + 14.0 * legend_rows_++;
+  constexpr double kRowY = 46.0;
   append_format(overlay_,
                 "<rect x=\"%.1f\" y=\"%.1f\" width=\"10\" height=\"10\" fill=\"%.*s\"/>"
                 "<text x=\"%.1f\" y=\"%.1f\" font-size=\"12\" font-family=\"sans-serif\">",
-                kMargin, y, static_cast<int>(colour.size()), colour.data(), kMargin + 14.0, y + 9.5);
+                legend_x_, kRowY, static_cast<int>(colour.size()), colour.data(), legend_x_ + 14.0,
+                kRowY + 9.5);
   overlay_ += escape(label);
   overlay_ += "</text>\n";
+  legend_x_ += 24.0 + 6.5 * static_cast<double>(label.size());
 }
 
 std::string SvgCanvas::str() const {
@@ -83,9 +85,15 @@ std::string SvgCanvas::str() const {
                 "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
                 "viewBox=\"0 0 %.0f %.0f\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
                 width_px_, height_px_, width_px_, height_px_);
-  append_format(out, "<text x=\"%.1f\" y=\"20\" font-size=\"16\" font-family=\"sans-serif\">", kMargin);
-  out += title_;
+  const std::size_t newline = title_.find('\n');
+  append_format(out, "<text x=\"%.1f\" y=\"18\" font-size=\"15\" font-family=\"sans-serif\">", kMargin);
+  out += title_.substr(0, newline);
   out += "</text>\n";
+  if (newline != std::string::npos) {
+    append_format(out, "<text x=\"%.1f\" y=\"36\" font-size=\"12\" font-family=\"sans-serif\">", kMargin);
+    out += title_.substr(newline + 1);
+    out += "</text>\n";
+  }
   out += body_;
   out += overlay_;
   out += "</svg>\n";

@@ -37,10 +37,14 @@ enum class SimdPath : unsigned char { kAuto, kAvx2, kSse2, kScalar };
 //
 // build() lays a uniform grid over the chain's bounding box and classifies every cell, with a
 // margin far larger than rounding error, as outside every ROI, inside at least one ROI, or
-// boundary. A boundary cell keeps the ascending list of ROIs that may contain some of its
-// points; a point in such a cell is decided by calling the same RoiSet::contains() the
-// reference calls, on those candidates only. Since every ROI left out of the list rejects
-// the point for sure, and any ROI that accepts it makes the reference keep it, both agree.
+// boundary. A boundary cell is split into 4 × 4 sub-cells, classified the same way against
+// the cell's candidates; a boundary sub-cell keeps the list of ROIs that may contain some of
+// its points, nearest first. A point there is decided by calling the same
+// RoiSet::contains() the reference calls, on those candidates only. Since every ROI left out
+// of the list rejects the point for sure, and any ROI that accepts it makes the reference
+// keep it, both agree. Cells are located in float, and every (sub-)cell is classified as if
+// enlarged by a margin that covers float rounding, so a point placed in a neighbouring cell
+// is still covered by that cell's classification.
 //
 // A filter() call allocates nothing once `kept` has the capacity; build() reuses its storage.
 template <typename RoiSet>
@@ -96,10 +100,16 @@ class GridFilter {
   std::size_t nx_ = 0;
   std::size_t ny_ = 0;
   std::vector<std::uint32_t> cells_;
-  std::vector<std::uint32_t> offsets_;     // boundary id → [offsets_[id], offsets_[id + 1])
-  std::vector<std::uint32_t> candidates_;  // ROI indices, nearest first within one cell
+  // Sub-cells per side of a boundary cell.
+  static constexpr std::uint32_t kSub = 4;
+  std::vector<std::uint32_t> sub_;             // boundary id · kSub² + sub-cell → value
+  std::vector<std::uint32_t> sub_offsets_;     // sub-boundary id → [first, last) candidate
+  std::vector<std::uint32_t> sub_candidates_;  // ROI indices, nearest first
+  std::vector<std::uint32_t> offsets_;         // build scratch: boundary cell → candidates
+  std::vector<std::uint32_t> candidates_;      // build scratch
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;  // build scratch: (cell, roi)
   std::vector<std::uint32_t> cursor_;                            // build scratch
+  std::vector<std::pair<double, double>> roi_centre_;            // build scratch
 };
 
 template <typename RoiSet>
@@ -211,28 +221,79 @@ void GridFilter<RoiSet>::build(const RoiSet& rois) {
   }
   // Nearest ROI first (by the centre of its bounds): a point inside the chain usually stops
   // at the first test. The decision is an OR over the list, so the order cannot change it.
+  roi_centre_.clear();
+  for (std::size_t j = 0; j < m; ++j) {
+    const Box b = rois.bounds(j);
+    roi_centre_.emplace_back(0.5 * (b.x_min + b.x_max), 0.5 * (b.y_min + b.y_max));
+  }
   for (std::size_t c = 0; c < nx_ * ny_; ++c) {
     if (cells_[c] < kFirstBoundary) continue;
     const std::uint32_t id = cells_[c] - kFirstBoundary;
     const double mx = x0 + (static_cast<double>(c % nx_) + 0.5) * h;
     const double my = y0 + (static_cast<double>(c / nx_) + 0.5) * h;
     auto distance2 = [&](std::uint32_t j) {
-      const Box b = rois.bounds(j);
-      const double dx = 0.5 * (b.x_min + b.x_max) - mx;
-      const double dy = 0.5 * (b.y_min + b.y_max) - my;
+      const double dx = roi_centre_[j].first - mx;
+      const double dy = roi_centre_[j].second - my;
       return dx * dx + dy * dy;
     };
     std::sort(candidates_.begin() + offsets_[id], candidates_.begin() + offsets_[id + 1],
               [&](std::uint32_t a, std::uint32_t b) { return distance2(a) < distance2(b); });
+  }
+
+  // Second level: each boundary cell is split into kSub × kSub sub-cells, classified against
+  // the cell's candidates with the same margins. Only points in boundary sub-cells run
+  // candidate tests, against the sub-cell's shorter list (still nearest first).
+  const double hs = h / kSub;
+  sub_.assign(static_cast<std::size_t>(boundary) * kSub * kSub, kOutside);
+  sub_offsets_.assign(1, 0);
+  sub_candidates_.clear();
+  for (std::size_t c = 0; c < nx_ * ny_; ++c) {
+    if (cells_[c] < kFirstBoundary) continue;
+    const std::uint32_t id = cells_[c] - kFirstBoundary;
+    const double cx0 = x0 + static_cast<double>(c % nx_) * h;
+    const double cy0 = y0 + static_cast<double>(c / nx_) * h;
+    for (std::uint32_t sy = 0; sy < kSub; ++sy) {
+      for (std::uint32_t sx = 0; sx < kSub; ++sx) {
+        const Box sub{cx0 + sx * hs - cell_pad, cy0 + sy * hs - cell_pad,
+                      cx0 + (sx + 1) * hs + cell_pad, cy0 + (sy + 1) * hs + cell_pad};
+        const std::size_t first = sub_candidates_.size();
+        std::uint32_t value = kOutside;
+        for (std::uint32_t k = offsets_[id]; k < offsets_[id + 1]; ++k) {
+          const CellRelation relation = rois.relation(candidates_[k], sub, tolerance);
+          if (relation == CellRelation::kInside) {
+            value = kInside;
+            break;
+          }
+          if (relation == CellRelation::kBoundary) sub_candidates_.push_back(candidates_[k]);
+        }
+        if (value == kInside) {
+          sub_candidates_.resize(first);
+        } else if (sub_candidates_.size() > first) {
+          value = kFirstBoundary + static_cast<std::uint32_t>(sub_offsets_.size() - 1);
+          sub_offsets_.push_back(static_cast<std::uint32_t>(sub_candidates_.size()));
+        }
+        sub_[static_cast<std::size_t>(id) * kSub * kSub + sy * kSub + sx] = value;
+      }
+    }
   }
 }
 
 template <typename RoiSet>
 std::uint32_t GridFilter<RoiSet>::decide(std::uint32_t cell, double x, double y) const noexcept {
   if (cell < kFirstBoundary) return cell;  // kOutside = 0, kInside = 1
-  const std::uint32_t id = cell - kFirstBoundary;
-  for (std::uint32_t k = offsets_[id]; k < offsets_[id + 1]; ++k) {
-    if (rois_->contains(candidates_[k], x, y)) return 1;
+  // The sub-cell from the same float arithmetic that chose the cell: its integer part is
+  // the cell, its fraction (exact in float) the position inside it.
+  const float fx = (static_cast<float>(x) - x0_) * inv_cell_;
+  const float fy = (static_cast<float>(y) - y0_) * inv_cell_;
+  const float frac_x = fx - static_cast<float>(static_cast<std::int32_t>(fx));
+  const float frac_y = fy - static_cast<float>(static_cast<std::int32_t>(fy));
+  const std::uint32_t sx = std::min(static_cast<std::uint32_t>(frac_x * kSub), kSub - 1);
+  const std::uint32_t sy = std::min(static_cast<std::uint32_t>(frac_y * kSub), kSub - 1);
+  const std::uint32_t sub = sub_[static_cast<std::size_t>(cell - kFirstBoundary) * kSub * kSub + sy * kSub + sx];
+  if (sub < kFirstBoundary) return sub;
+  const std::uint32_t id = sub - kFirstBoundary;
+  for (std::uint32_t k = sub_offsets_[id]; k < sub_offsets_[id + 1]; ++k) {
+    if (rois_->contains(sub_candidates_[k], x, y)) return 1;
   }
   return 0;
 }
@@ -381,87 +442,138 @@ struct CompressTable {
 inline constexpr CompressTable kCompress{};
 }  // namespace detail
 
+namespace detail {
+// What the AVX2 scan needs to locate eight points' cells.
+struct Avx2Grid {
+  __m256 x0, y0, inv, nx_f, ny_f, z_lo, z_hi;
+  __m256i nx_i, sentinel;
+  bool z_limited;
+  const int* cells;
+};
+
+// The cell values of the eight points at `p` (x, y, z, intensity each), in point order;
+// `clean` is false when one of them is non-finite or outside the z limits.
+struct Avx2Block {
+  __m256i value;
+  bool clean;
+};
+
+__attribute__((target("avx2"), always_inline)) inline Avx2Block avx2_block(const float* p,
+                                                                          const Avx2Grid& g) {
+  const __m256 a = _mm256_loadu_ps(p);       // points 0, 1
+  const __m256 b = _mm256_loadu_ps(p + 8);   // points 2, 3
+  const __m256 c = _mm256_loadu_ps(p + 16);  // points 4, 5
+  const __m256 d = _mm256_loadu_ps(p + 24);  // points 6, 7
+  const __m256 t0 = _mm256_unpacklo_ps(a, b);  // x0 x2 y0 y2 | x1 x3 y1 y3
+  const __m256 t1 = _mm256_unpackhi_ps(a, b);  // z0 z2 . .   | z1 z3 . .
+  const __m256 t2 = _mm256_unpacklo_ps(c, d);
+  const __m256 t3 = _mm256_unpackhi_ps(c, d);
+  const __m256 px = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));  // x 0 2 4 6 | 1 3 5 7
+  const __m256 py = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
+  const __m256 pz = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
+  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  const __m256 max_finite = _mm256_set1_ps(std::numeric_limits<float>::max());
+  __m256 pass = _mm256_and_ps(
+      _mm256_and_ps(_mm256_cmp_ps(_mm256_and_ps(px, abs_mask), max_finite, _CMP_LE_OQ),
+                    _mm256_cmp_ps(_mm256_and_ps(py, abs_mask), max_finite, _CMP_LE_OQ)),
+      _mm256_cmp_ps(_mm256_and_ps(pz, abs_mask), max_finite, _CMP_LE_OQ));
+  if (g.z_limited) {
+    pass = _mm256_and_ps(pass, _mm256_and_ps(_mm256_cmp_ps(pz, g.z_lo, _CMP_GE_OQ),
+                                             _mm256_cmp_ps(pz, g.z_hi, _CMP_LE_OQ)));
+  }
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 fx = _mm256_mul_ps(_mm256_sub_ps(px, g.x0), g.inv);
+  const __m256 fy = _mm256_mul_ps(_mm256_sub_ps(py, g.y0), g.inv);
+  const __m256 on_grid = _mm256_and_ps(
+      _mm256_and_ps(_mm256_cmp_ps(fx, zero, _CMP_GE_OQ), _mm256_cmp_ps(fx, g.nx_f, _CMP_LT_OQ)),
+      _mm256_and_ps(_mm256_cmp_ps(fy, zero, _CMP_GE_OQ), _mm256_cmp_ps(fy, g.ny_f, _CMP_LT_OQ)));
+  // Off-grid lanes are zeroed before converting; on-grid values are ≥ 0 (truncation floors).
+  const __m256i ix = _mm256_cvttps_epi32(_mm256_and_ps(fx, on_grid));
+  const __m256i iy = _mm256_cvttps_epi32(_mm256_and_ps(fy, on_grid));
+  const __m256i cell = _mm256_blendv_epi8(g.sentinel, _mm256_add_epi32(_mm256_mullo_epi32(iy, g.nx_i), ix),
+                                          _mm256_castps_si256(on_grid));
+  // The transposition left the points in lane order 0 2 4 6 1 3 5 7; put them back.
+  const __m256i natural = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
+  return {_mm256_i32gather_epi32(g.cells, _mm256_permutevar8x32_epi32(cell, natural), 4),
+          _mm256_movemask_ps(pass) == 0xff};
+}
+
+// Writes the indices first … first + 7 whose cell value is 1 (inside) to out, packed;
+// returns how many. All eight values must be 0 or 1. Writes eight slots at `out`.
+__attribute__((target("avx2,popcnt"), always_inline)) inline std::size_t avx2_emit(
+    __m256i value, std::size_t first, std::uint32_t* out) {
+  const __m256i one = _mm256_set1_epi32(1);
+  const auto keep = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(value, one))));
+  const __m256i indices = _mm256_add_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(first)),
+                                           _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+  const __m256i packed = _mm256_permutevar8x32_epi32(
+      indices, _mm256_load_si256(reinterpret_cast<const __m256i*>(kCompress.lanes[keep])));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), packed);
+  return static_cast<std::size_t>(__builtin_popcount(keep));
+}
+
+__attribute__((target("avx2"), always_inline)) inline void avx2_store(__m256i value, std::uint32_t* out) {
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), value);
+}
+
+__attribute__((target("avx2"), always_inline)) inline bool avx2_any_boundary(__m256i value) {
+  return _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(value, _mm256_set1_epi32(1)))) != 0;
+}
+}  // namespace detail
+
 template <typename RoiSet>
 __attribute__((target("avx2,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx2(
     std::span<const PointXYZI> points, Scan& scan) const {
   if (points.size() < 8) return 0;
   const ZLimits& z_limits = rois_->z_limits();
-  const bool z_limited = std::isfinite(z_limits.min_m) || std::isfinite(z_limits.max_m);
-  const __m256 lo = _mm256_set1_ps(float_at_or_above(std::max(z_limits.min_m, -double{std::numeric_limits<float>::max()})));
-  const __m256 hi = _mm256_set1_ps(float_at_or_below(std::min(z_limits.max_m, double{std::numeric_limits<float>::max()})));
-  const __m256 x0 = _mm256_set1_ps(x0_);
-  const __m256 y0 = _mm256_set1_ps(y0_);
-  const __m256 inv = _mm256_set1_ps(inv_cell_);
-  const __m256 nx_f = _mm256_set1_ps(static_cast<float>(nx_));
-  const __m256 ny_f = _mm256_set1_ps(static_cast<float>(ny_));
-  const __m256i nx_i = _mm256_set1_epi32(static_cast<std::int32_t>(nx_));
-  const __m256 zero = _mm256_setzero_ps();
-  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-  const __m256 max_finite = _mm256_set1_ps(std::numeric_limits<float>::max());
-  const __m256i sentinel = _mm256_set1_epi32(static_cast<std::int32_t>(cells_.size() - 1));
-  const __m256i one = _mm256_set1_epi32(1);
-  // The transposition below leaves points in lane order 0 2 4 6 1 3 5 7; this puts them back.
-  const __m256i natural = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
-  const __m256i lane_offset = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  const auto* const cells = reinterpret_cast<const int*>(cells_.data());
+  const detail::Avx2Grid grid{
+      _mm256_set1_ps(x0_),
+      _mm256_set1_ps(y0_),
+      _mm256_set1_ps(inv_cell_),
+      _mm256_set1_ps(static_cast<float>(nx_)),
+      _mm256_set1_ps(static_cast<float>(ny_)),
+      _mm256_set1_ps(float_at_or_above(std::max(z_limits.min_m, -double{std::numeric_limits<float>::max()}))),
+      _mm256_set1_ps(float_at_or_below(std::min(z_limits.max_m, double{std::numeric_limits<float>::max()}))),
+      _mm256_set1_epi32(static_cast<std::int32_t>(nx_)),
+      _mm256_set1_epi32(static_cast<std::int32_t>(cells_.size() - 1)),
+      std::isfinite(z_limits.min_m) || std::isfinite(z_limits.max_m),
+      reinterpret_cast<const int*>(cells_.data())};
   const float* const base = &points.data()->x;
   std::uint32_t* const out = scan.out;
   std::size_t count = scan.count;
-  alignas(32) std::uint32_t cell_value[8];
-  std::size_t i = 0;
-  for (; i + 8 <= points.size(); i += 8) {
-    const __m256 a = _mm256_loadu_ps(base + 4 * i);       // points 0, 1
-    const __m256 b = _mm256_loadu_ps(base + 4 * i + 8);   // points 2, 3
-    const __m256 c = _mm256_loadu_ps(base + 4 * i + 16);  // points 4, 5
-    const __m256 d = _mm256_loadu_ps(base + 4 * i + 24);  // points 6, 7
-    const __m256 t0 = _mm256_unpacklo_ps(a, b);           // x0 x2 y0 y2 | x1 x3 y1 y3
-    const __m256 t1 = _mm256_unpackhi_ps(a, b);           // z0 z2 . .   | z1 z3 . .
-    const __m256 t2 = _mm256_unpacklo_ps(c, d);
-    const __m256 t3 = _mm256_unpackhi_ps(c, d);
-    const __m256 px = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));  // x 0 2 4 6 | 1 3 5 7
-    const __m256 py = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
-    const __m256 pz = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
-    __m256 pass = _mm256_and_ps(
-        _mm256_and_ps(_mm256_cmp_ps(_mm256_and_ps(px, abs_mask), max_finite, _CMP_LE_OQ),
-                      _mm256_cmp_ps(_mm256_and_ps(py, abs_mask), max_finite, _CMP_LE_OQ)),
-        _mm256_cmp_ps(_mm256_and_ps(pz, abs_mask), max_finite, _CMP_LE_OQ));
-    if (z_limited) {
-      pass = _mm256_and_ps(pass, _mm256_and_ps(_mm256_cmp_ps(pz, lo, _CMP_GE_OQ),
-                                               _mm256_cmp_ps(pz, hi, _CMP_LE_OQ)));
-    }
-    if (_mm256_movemask_ps(pass) != 0xff) [[unlikely]] {
+  std::uint32_t cell_value[8];
+  // Slow paths of one block: a point to reject (the scalar code counts why), or points in
+  // boundary cells (their candidates are tested), with the block's cell values in cell_value.
+  auto slow_block = [&](std::size_t first, bool clean) {
+    if (!clean) {
       scan.count = count;
-      for (std::size_t k = i; k < i + 8; ++k) scalar_point(points, k, scan);
+      for (std::size_t k = first; k < first + 8; ++k) scalar_point(points, k, scan);
       count = scan.count;
-      continue;
+      return;
     }
-    const __m256 fx = _mm256_mul_ps(_mm256_sub_ps(px, x0), inv);
-    const __m256 fy = _mm256_mul_ps(_mm256_sub_ps(py, y0), inv);
-    const __m256 on_grid = _mm256_and_ps(
-        _mm256_and_ps(_mm256_cmp_ps(fx, zero, _CMP_GE_OQ), _mm256_cmp_ps(fx, nx_f, _CMP_LT_OQ)),
-        _mm256_and_ps(_mm256_cmp_ps(fy, zero, _CMP_GE_OQ), _mm256_cmp_ps(fy, ny_f, _CMP_LT_OQ)));
-    const __m256i ix = _mm256_cvttps_epi32(_mm256_and_ps(fx, on_grid));
-    const __m256i iy = _mm256_cvttps_epi32(_mm256_and_ps(fy, on_grid));
-    const __m256i cell = _mm256_blendv_epi8(sentinel, _mm256_add_epi32(_mm256_mullo_epi32(iy, nx_i), ix),
-                                            _mm256_castps_si256(on_grid));
-    const __m256i value = _mm256_i32gather_epi32(cells, _mm256_permutevar8x32_epi32(cell, natural), 4);
-    if (_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(value, one))) != 0) [[unlikely]] {
-      _mm256_store_si256(reinterpret_cast<__m256i*>(cell_value), value);
-      for (std::size_t k = 0; k < 8; ++k) {
-        out[count] = static_cast<std::uint32_t>(i + k);
-        count += decide(cell_value[k], points[i + k].x, points[i + k].y);
-      }
-      continue;
+    for (std::size_t k = 0; k < 8; ++k) {
+      out[count] = static_cast<std::uint32_t>(first + k);
+      count += decide(cell_value[k], points[first + k].x, points[first + k].y);
     }
-    const auto keep = static_cast<unsigned>(
-        _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(value, one))));
-    // count ≤ i, so the 8-lane store stays inside the first i + 8 ≤ n slots of `out`.
-    const __m256i indices = _mm256_add_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(i)), lane_offset);
-    const __m256i packed = _mm256_permutevar8x32_epi32(
-        indices, _mm256_load_si256(reinterpret_cast<const __m256i*>(detail::kCompress.lanes[keep])));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + count), packed);
-    count += static_cast<std::size_t>(__builtin_popcount(keep));
+  };
+  auto finish = [&](std::size_t first, const detail::Avx2Block& block) __attribute__((target("avx2,popcnt"))) {
+    if (block.clean && !detail::avx2_any_boundary(block.value)) [[likely]] {
+      count += detail::avx2_emit(block.value, first, out + count);
+      return;
+    }
+    detail::avx2_store(block.value, cell_value);
+    slow_block(first, block.clean);
+  };
+  // Two blocks per step, so both gathers are in flight before either result is used. Since
+  // count ≤ first, an 8-slot store at out + count stays within the first + 8 ≤ n slots.
+  std::size_t i = 0;
+  for (; i + 16 <= points.size(); i += 16) {
+    const detail::Avx2Block a = detail::avx2_block(base + 4 * i, grid);
+    const detail::Avx2Block b = detail::avx2_block(base + 4 * (i + 8), grid);
+    finish(i, a);
+    finish(i + 8, b);
   }
+  for (; i + 8 <= points.size(); i += 8) finish(i, detail::avx2_block(base + 4 * i, grid));
   scan.count = count;
   return i;
 }

@@ -85,6 +85,8 @@ struct RectGeometry {
   double bcx, bcy;  // BC = C − B
   double ab2;       // ‖AB‖²
   double bc2;       // ‖BC‖²
+  double ab;        // ‖AB‖ (for the grid's margins only; the test uses the squares)
+  double bc;        // ‖BC‖
 };
 
 [[nodiscard]] RectGeometry make_rect_geometry(double cx, double cy, double theta_rad,

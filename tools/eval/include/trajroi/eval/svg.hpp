@@ -11,7 +11,8 @@ namespace trajroi::eval {
 // Builds the document in memory; str() returns it complete.
 class SvgCanvas {
  public:
-  // The drawing covers [x_min, x_max] × [y_min, y_max] plus a margin, at px_per_m.
+  // The drawing covers [x_min, x_max] × [y_min, y_max] plus a margin, at px_per_m. The title
+  // may hold one '\n': the text after it becomes a smaller second line.
   SvgCanvas(double x_min, double y_min, double x_max, double y_max, double px_per_m,
             std::string_view title);
 
@@ -21,7 +22,7 @@ class SvgCanvas {
                double width_px = 1.0);
   void polyline(std::span<const Eigen::Vector2d> points, std::string_view colour,
                 double width_px = 1.5);
-  // A legend entry in the top-left corner, one per call, in call order.
+  // A legend entry in the header's legend row, one per call, left to right.
   void legend(std::string_view colour, std::string_view label);
 
   [[nodiscard]] std::string str() const;
@@ -31,13 +32,13 @@ class SvgCanvas {
   [[nodiscard]] double py(double y) const noexcept { return (y_max_ - y) * scale_ + kMargin + kHeader; }
 
   static constexpr double kMargin = 20.0;
-  static constexpr double kHeader = 30.0;
+  static constexpr double kHeader = 64.0;  // two title lines and the legend row
   double x_min_;
   double y_max_;
   double scale_;
   double width_px_;
   double height_px_;
-  int legend_rows_ = 0;
+  double legend_x_ = kMargin;
   std::string body_;
   std::string overlay_;
   std::string title_;

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Runs the ROI benchmarks (medians of repeated runs) and prints the issue's goals as ratios
+# measured in the same run. Usage: scripts/bench-roi.sh [build dir]   (default build/release)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=${1:-build/release}
+out=$(mktemp)
+trap 'rm -f "$out"' EXIT
+"$build/bench/roi_bench" --benchmark_min_time=0.5 --benchmark_repetitions=7 \
+  --benchmark_report_aggregates_only=true --benchmark_format=console 2>/dev/null |
+  awk '/_median/ { name = $1; sub(/_median$/, "", name); t = $2; if ($3 == "us") t /= 1000; print name, t }' >"$out"
+
+awk '
+  { ms[$1] = $2; order[++n] = $1 }
+  END {
+    printf "%-44s %12s\n", "benchmark (median)", "time [ms]"
+    for (k = 1; k <= n; ++k) printf "%-44s %12.4f\n", order[k], ms[order[k]]
+    printf "\nGoals on the accumulated cloud (2.88 M points), same run:\n"
+    fails = 0
+    split("circular rectangular", shapes, " ")
+    want["circular", 25] = 3; want["circular", 10] = 7
+    want["rectangular", 25] = 6; want["rectangular", 10] = 14
+    memcpy = ms["limit/memcpy/accumulated"]
+    for (s = 1; s <= 2; ++s) {
+      shape = shapes[s]
+      for (r = 25; r >= 10; r -= 15) {
+        ref = ms["roi/" shape "/reference/accumulated/" r]; fast = ms["roi/" shape "/fast/accumulated/" r]
+        ok = ref / fast >= want[shape, r]; fails += !ok
+        printf "  %-11s %2d %%: fast %6.1fx faster than reference (goal >= %2dx)   %s\n", shape, r, ref / fast, want[shape, r], ok ? "met" : "MISSED"
+        ok = fast / memcpy <= 1.5; fails += !ok
+        printf "  %-11s %2d %%: fast = %4.2fx the memcpy of the same points (goal <= 1.5x)  %s\n", shape, r, fast / memcpy, ok ? "met" : "MISSED"
+      }
+      f10 = ms["roi/" shape "/fast/accumulated/10"]; f25 = ms["roi/" shape "/fast/accumulated/25"]
+      ok = f10 / f25 <= 1.25; fails += !ok
+      printf "  %-11s fast at 10 %% = %4.2fx fast at 25 %% (goal <= 1.25x)                %s\n", shape, f10 / f25, ok ? "met" : "MISSED"
+    }
+    exit fails > 0
+  }' "$out"
