@@ -88,7 +88,7 @@ class GridFilter {
 #endif
 
   // 0/1: is the point (x, y) in a cell with this value kept? Tests candidates for boundary cells.
-  [[nodiscard]] std::uint32_t decide(std::uint32_t cell, double x, double y) const noexcept;
+  [[nodiscard, gnu::always_inline]] inline std::uint32_t decide(std::uint32_t cell, double x, double y) const noexcept;
   // Index into cells_ of the cell holding (x, y); the sentinel when off the grid.
   [[nodiscard]] std::size_t cell_index(float x, float y) const noexcept;
 
