@@ -51,20 +51,22 @@ void SvgCanvas::circle(double cx, double cy, double radius_m, std::string_view c
                 width_px);
 }
 
+void SvgCanvas::path_element(const char* tag, std::span<const Eigen::Vector2d> points,
+                             std::string_view colour, double width_px, double opacity) {
+  append_format(overlay_, "<%s points=\"", tag);
+  for (const Eigen::Vector2d& p : points) append_format(overlay_, "%.2f,%.2f ", px(p.x()), py(p.y()));
+  append_format(overlay_, "\" fill=\"none\" stroke=\"%.*s\" stroke-width=\"%.1f\" stroke-opacity=\"%.2f\"/>\n",
+                static_cast<int>(colour.size()), colour.data(), width_px, opacity);
+}
+
 void SvgCanvas::polygon(std::span<const Eigen::Vector2d> corners, std::string_view colour,
                         double width_px) {
-  overlay_ += "<polygon points=\"";
-  for (const Eigen::Vector2d& c : corners) append_format(overlay_, "%.2f,%.2f ", px(c.x()), py(c.y()));
-  append_format(overlay_, "\" fill=\"none\" stroke=\"%.*s\" stroke-width=\"%.1f\" stroke-opacity=\"0.7\"/>\n",
-                static_cast<int>(colour.size()), colour.data(), width_px);
+  path_element("polygon", corners, colour, width_px, 0.7);
 }
 
 void SvgCanvas::polyline(std::span<const Eigen::Vector2d> points, std::string_view colour,
                          double width_px) {
-  overlay_ += "<polyline points=\"";
-  for (const Eigen::Vector2d& p : points) append_format(overlay_, "%.2f,%.2f ", px(p.x()), py(p.y()));
-  append_format(overlay_, "\" fill=\"none\" stroke=\"%.*s\" stroke-width=\"%.1f\"/>\n",
-                static_cast<int>(colour.size()), colour.data(), width_px);
+  path_element("polyline", points, colour, width_px, 1.0);
 }
 
 void SvgCanvas::legend(std::string_view colour, std::string_view label) {

@@ -28,6 +28,9 @@ class SvgCanvas {
   [[nodiscard]] std::string str() const;
 
  private:
+  // <polygon> or <polyline> through the points, unfilled.
+  void path_element(const char* tag, std::span<const Eigen::Vector2d> points,
+                    std::string_view colour, double width_px, double opacity);
   [[nodiscard]] double px(double x) const noexcept { return (x - x_min_) * scale_ + kMargin; }
   [[nodiscard]] double py(double y) const noexcept { return (y_max_ - y) * scale_ + kMargin + kHeader; }
 
