@@ -121,8 +121,7 @@ void GridFilter<RoiSet>::build(const RoiSet& rois) {
   pairs_.clear();
   nx_ = ny_ = 0;
   const std::size_t m = rois.size();
-  if (m == 0) {
-    nx_ = ny_ = 0;  // no point is on a 0 × 0 grid: all read the sentinel
+  if (m == 0) {  // no point is on a 0 × 0 grid: all read the sentinel
     cells_.assign(1, kOutside);
     return;
   }
@@ -153,7 +152,6 @@ void GridFilter<RoiSet>::build(const RoiSet& rois) {
     h = std::sqrt(width * height / static_cast<double>(kMaxCells)) * 1.01;
     while (std::ceil(width / h) * std::ceil(height / h) > static_cast<double>(kMaxCells)) h *= 1.01;
   }
-  cell_size_m_ = h;
   // The float origin and scale filter() uses define the grid; classification uses the same
   // values widened to double, so both describe the same cells up to float rounding.
   x0_ = float_at_or_below(bb.x_min);
@@ -163,10 +161,9 @@ void GridFilter<RoiSet>::build(const RoiSet& rois) {
   cell_size_m_ = h;
   nx_ = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil((bb.x_max - static_cast<double>(x0_)) / h)));
   ny_ = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil((bb.y_max - static_cast<double>(y0_)) / h)));
-  if (nx_ * ny_ > kMaxCells + (nx_ + ny_)) nx_ = ny_ = 1;  // unreachable; keeps the bound obvious
   cells_.assign(nx_ * ny_ + 1, kOutside);  // + the sentinel cell for off-grid points
 
-  auto cell_index = [](double v, float origin, float inv, std::size_t n) {
+  auto cell_at = [](double v, float origin, float inv, std::size_t n) {
     const double f = std::floor((v - static_cast<double>(origin)) * static_cast<double>(inv));
     if (!(f > 0.0)) return std::size_t{0};
     return std::min(static_cast<std::size_t>(f), n - 1);
@@ -176,10 +173,10 @@ void GridFilter<RoiSet>::build(const RoiSet& rois) {
   for (std::size_t j = 0; j < m; ++j) {
     const Box b = rois.bounds(j);
     const double reach = tolerance + cell_pad;
-    const std::size_t ix0 = cell_index(b.x_min - reach, x0_, inv_cell_, nx_);
-    const std::size_t ix1 = cell_index(b.x_max + reach, x0_, inv_cell_, nx_);
-    const std::size_t iy0 = cell_index(b.y_min - reach, y0_, inv_cell_, ny_);
-    const std::size_t iy1 = cell_index(b.y_max + reach, y0_, inv_cell_, ny_);
+    const std::size_t ix0 = cell_at(b.x_min - reach, x0_, inv_cell_, nx_);
+    const std::size_t ix1 = cell_at(b.x_max + reach, x0_, inv_cell_, nx_);
+    const std::size_t iy0 = cell_at(b.y_min - reach, y0_, inv_cell_, ny_);
+    const std::size_t iy1 = cell_at(b.y_max + reach, y0_, inv_cell_, ny_);
     for (std::size_t iy = iy0; iy <= iy1; ++iy) {
       for (std::size_t ix = ix0; ix <= ix1; ++ix) {
         const std::size_t c = iy * nx_ + ix;
