@@ -1,0 +1,82 @@
+#pragma once
+
+// The VLP-16 data packet (VLP-16 User Manual, "Sensor Data"): the 1206-byte UDP payload on
+// port 2368, described as named offsets and little-endian accessors over bytes. No struct
+// casts: every field is read with byte shifts.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+namespace trajroi::vlp16 {
+
+inline constexpr std::size_t kDataPacketBytes = 1206;
+inline constexpr std::size_t kBlocks = 12;
+inline constexpr std::size_t kBlockBytes = 100;       // flag 2 + azimuth 2 + 32 × 3
+inline constexpr std::size_t kLasers = 16;
+inline constexpr std::size_t kFiringsPerBlock = 2;    // two firing sequences of 16 lasers
+inline constexpr std::size_t kTimestampOffset = 1200; // µs past the hour, uint32 LE
+inline constexpr std::size_t kReturnModeOffset = 1204;
+inline constexpr std::size_t kProductIdOffset = 1205;
+inline constexpr std::uint16_t kBlockFlag = 0xEEFF;   // bytes FF EE, read little-endian
+inline constexpr std::uint16_t kAzimuthLimit = 36000; // hundredths of a degree
+inline constexpr double kDistanceUnit_m = 0.002;
+inline constexpr double kLaserPeriod_us = 2.304;      // between two lasers of one firing
+inline constexpr double kFiringCycle_us = 55.296;     // one firing sequence, recharge included
+
+enum class ReturnMode : std::uint8_t { kStrongest = 0x37, kLast = 0x38, kDual = 0x39 };
+inline constexpr std::uint8_t kProductVlp16 = 0x22;
+inline constexpr std::uint8_t kProductHdl32e = 0x21;
+
+// Why a data packet was not decoded. Counted by the caller, never thrown.
+enum class PacketError : std::uint8_t {
+  kNone,
+  kWrongSize,
+  kBadBlockFlag,
+  kAzimuthOutOfRange,
+  kUnknownReturnMode,
+  kUnsupportedProduct,
+};
+inline constexpr std::size_t kPacketErrorCount = 6;
+[[nodiscard]] std::string_view to_string(PacketError error) noexcept;
+
+[[nodiscard]] inline std::uint16_t read_u16(std::span<const std::uint8_t> b, std::size_t at) noexcept {
+  return static_cast<std::uint16_t>(b[at] | (b[at + 1] << 8));
+}
+[[nodiscard]] inline std::uint32_t read_u32(std::span<const std::uint8_t> b, std::size_t at) noexcept {
+  return static_cast<std::uint32_t>(b[at]) | (static_cast<std::uint32_t>(b[at + 1]) << 8) |
+         (static_cast<std::uint32_t>(b[at + 2]) << 16) | (static_cast<std::uint32_t>(b[at + 3]) << 24);
+}
+
+// Field accessors; the packet must have been validated (validate_data_packet() == kNone).
+[[nodiscard]] inline std::uint16_t block_azimuth(std::span<const std::uint8_t> p, std::size_t block) noexcept {
+  return read_u16(p, block * kBlockBytes + 2);
+}
+// Channel 0 … 31 of a block: firing sequence channel / 16, laser channel % 16.
+[[nodiscard]] inline std::uint16_t channel_distance(std::span<const std::uint8_t> p, std::size_t block,
+                                                    std::size_t channel) noexcept {
+  return read_u16(p, block * kBlockBytes + 4 + channel * 3);
+}
+[[nodiscard]] inline std::uint8_t channel_reflectivity(std::span<const std::uint8_t> p, std::size_t block,
+                                                       std::size_t channel) noexcept {
+  return p[block * kBlockBytes + 4 + channel * 3 + 2];
+}
+[[nodiscard]] inline std::uint32_t timestamp_us(std::span<const std::uint8_t> p) noexcept {
+  return read_u32(p, kTimestampOffset);
+}
+[[nodiscard]] inline std::uint8_t return_mode_byte(std::span<const std::uint8_t> p) noexcept {
+  return p[kReturnModeOffset];
+}
+[[nodiscard]] inline std::uint8_t product_id(std::span<const std::uint8_t> p) noexcept {
+  return p[kProductIdOffset];
+}
+
+// Checks size, every block flag and azimuth, the return mode and the product id. Product
+// 0x22 (VLP-16) and 0x21 (HDL-32E code, sent by early VLP-16 firmware; the caller decides
+// from the packet timing) pass; any other id is kUnsupportedProduct.
+[[nodiscard]] PacketError validate_data_packet(std::span<const std::uint8_t> packet) noexcept;
+
+// A readable name for a product id byte ("VLP-32C" for 0x28), for rejection messages.
+[[nodiscard]] std::string_view product_name(std::uint8_t id) noexcept;
+
+}  // namespace trajroi::vlp16

@@ -1,0 +1,114 @@
+#include "trajroi/vlp16/pcap_source.hpp"
+
+#include <pcap/pcap.h>
+
+#include <stdexcept>
+
+namespace trajroi::vlp16 {
+namespace {
+
+constexpr int kLinkEthernet = 1;    // DLT_EN10MB
+constexpr int kLinkRaw = 101;       // LINKTYPE_RAW (DLT_RAW differs per platform)
+constexpr int kLinkRawAlt = 12;     // DLT_RAW on Linux
+constexpr int kLinkIpv4 = 228;      // LINKTYPE_IPV4
+constexpr int kLinkSll = 113;       // LINKTYPE_LINUX_SLL
+constexpr int kLinkSll2 = 276;      // LINKTYPE_LINUX_SLL2
+constexpr std::uint16_t kEtherIpv4 = 0x0800;
+constexpr std::uint16_t kEtherVlan = 0x8100;
+constexpr std::uint16_t kEtherQinQ = 0x88A8;
+constexpr std::uint8_t kIpProtoUdp = 17;
+
+std::uint16_t be16(const std::uint8_t* p) { return static_cast<std::uint16_t>((p[0] << 8) | p[1]); }
+
+// Offset of the IPv4 header in a frame of this link type, or −1 when the frame is not IPv4.
+long ipv4_offset(int link, const std::uint8_t* frame, std::size_t length) {
+  switch (link) {
+    case kLinkEthernet: {
+      std::size_t at = 12;
+      if (length < at + 2) return -1;
+      std::uint16_t type = be16(frame + at);
+      while ((type == kEtherVlan || type == kEtherQinQ) && length >= at + 6) {
+        at += 4;
+        type = be16(frame + at);
+      }
+      return type == kEtherIpv4 ? static_cast<long>(at + 2) : -1;
+    }
+    case kLinkSll:  // 16-byte header, protocol at 14
+      return length >= 16 && be16(frame + 14) == kEtherIpv4 ? 16 : -1;
+    case kLinkSll2:  // 20-byte header, protocol at 0
+      return length >= 20 && be16(frame) == kEtherIpv4 ? 20 : -1;
+    case kLinkRaw:
+    case kLinkRawAlt:
+    case kLinkIpv4:
+      return length >= 1 && (frame[0] >> 4) == 4 ? 0 : -1;
+    default:
+      return -1;
+  }
+}
+
+}  // namespace
+
+struct PcapSource::Handle {
+  pcap_t* pcap = nullptr;
+  ~Handle() {
+    if (pcap != nullptr) pcap_close(pcap);
+  }
+};
+
+PcapSource::PcapSource(const std::filesystem::path& path) : handle_(std::make_unique<Handle>()) {
+  char message[PCAP_ERRBUF_SIZE] = {};
+  handle_->pcap = pcap_open_offline_with_tstamp_precision(path.c_str(), PCAP_TSTAMP_PRECISION_NANO, message);
+  if (handle_->pcap == nullptr) {
+    throw std::runtime_error(path.string() + ": cannot open capture: " + message);
+  }
+  link_type_ = pcap_datalink(handle_->pcap);
+  if (link_type_ != kLinkEthernet && link_type_ != kLinkSll && link_type_ != kLinkSll2 &&
+      link_type_ != kLinkRaw && link_type_ != kLinkRawAlt && link_type_ != kLinkIpv4) {
+    throw std::runtime_error(path.string() + ": unsupported link type " + std::to_string(link_type_));
+  }
+}
+
+PcapSource::~PcapSource() = default;
+
+PcapSource::Next PcapSource::next(CapturedDatagram& datagram) {
+  while (true) {
+    pcap_pkthdr* header = nullptr;
+    const std::uint8_t* frame = nullptr;
+    const int status = pcap_next_ex(handle_->pcap, &header, &frame);
+    if (status == PCAP_ERROR_BREAK) return Next::kEnd;
+    if (status != 1) {
+      error_ = pcap_geterr(handle_->pcap);
+      return Next::kError;
+    }
+    const std::size_t length = header->caplen;
+    const long ip = ipv4_offset(link_type_, frame, length);
+    if (ip < 0) {
+      ++skipped_;
+      continue;
+    }
+    const auto at = static_cast<std::size_t>(ip);
+    if (length < at + 20) {
+      ++skipped_;
+      continue;
+    }
+    const std::size_t ihl = static_cast<std::size_t>(frame[at] & 0x0F) * 4;
+    const std::uint16_t fragment = be16(frame + at + 6) & 0x1FFF;
+    if (ihl < 20 || frame[at + 9] != kIpProtoUdp || fragment != 0 || length < at + ihl + 8) {
+      ++skipped_;
+      continue;
+    }
+    const std::size_t udp = at + ihl;
+    const std::size_t udp_length = be16(frame + udp + 4);
+    if (udp_length < 8 || length < udp + udp_length) {  // truncated by the snap length
+      ++skipped_;
+      continue;
+    }
+    datagram.payload = std::span<const std::uint8_t>(frame + udp + 8, udp_length - 8);
+    datagram.destination_port = be16(frame + udp + 2);
+    datagram.capture_time_ns = static_cast<std::int64_t>(header->ts.tv_sec) * 1'000'000'000 +
+                               static_cast<std::int64_t>(header->ts.tv_usec);  // ns precision
+    return Next::kDatagram;
+  }
+}
+
+}  // namespace trajroi::vlp16

@@ -1,0 +1,167 @@
+// VLP-16 data packets built byte by byte in the test; expected values from the VLP-16
+// manual's formulas, written out here independently of the decoder.
+#include "trajroi/vlp16/decoder.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+namespace trajroi::vlp16 {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// A packet whose block n has azimuth (first + step · n) mod 36000, every distance 0.
+std::vector<std::uint8_t> make_packet(std::uint16_t first_cdeg, std::uint16_t step_cdeg, ReturnMode mode,
+                                      std::uint8_t product = 0x22, std::uint32_t toh_us = 123456) {
+  std::vector<std::uint8_t> p(kDataPacketBytes, 0);
+  const bool dual = mode == ReturnMode::kDual;
+  for (std::size_t block = 0; block < kBlocks; ++block) {
+    const std::size_t firing_index = dual ? block / 2 : block;
+    const auto azimuth = static_cast<std::uint16_t>((first_cdeg + step_cdeg * firing_index) % 36000);
+    p[block * 100] = 0xFF;
+    p[block * 100 + 1] = 0xEE;
+    p[block * 100 + 2] = static_cast<std::uint8_t>(azimuth & 0xFF);
+    p[block * 100 + 3] = static_cast<std::uint8_t>(azimuth >> 8);
+  }
+  for (std::size_t k = 0; k < 4; ++k) p[1200 + k] = static_cast<std::uint8_t>(toh_us >> (8 * k));
+  p[1204] = static_cast<std::uint8_t>(mode);
+  p[1205] = product;
+  return p;
+}
+
+void set_return(std::vector<std::uint8_t>& p, std::size_t block, std::size_t channel, std::uint16_t distance_2mm,
+                std::uint8_t reflectivity) {
+  const std::size_t at = block * 100 + 4 + channel * 3;
+  p[at] = static_cast<std::uint8_t>(distance_2mm & 0xFF);
+  p[at + 1] = static_cast<std::uint8_t>(distance_2mm >> 8);
+  p[at + 2] = reflectivity;
+}
+
+TEST(Vlp16Packet, AccessorsReadLittleEndianFields) {
+  auto p = make_packet(1000, 40, ReturnMode::kStrongest, 0x22, 0x01020304);
+  set_return(p, 5, 31, 0xABCD, 9);
+  EXPECT_EQ(validate_data_packet(p), PacketError::kNone);
+  EXPECT_EQ(block_azimuth(p, 5), 1200);
+  EXPECT_EQ(channel_distance(p, 5, 31), 0xABCD);
+  EXPECT_EQ(channel_reflectivity(p, 5, 31), 9);
+  EXPECT_EQ(timestamp_us(p), 0x01020304u);
+}
+
+TEST(Vlp16Packet, EveryRejectionReason) {
+  auto good = make_packet(0, 40, ReturnMode::kStrongest);
+  EXPECT_EQ(validate_data_packet(std::span(good).first(1205)), PacketError::kWrongSize);
+  std::vector<std::uint8_t> longer = good;
+  longer.push_back(0);
+  EXPECT_EQ(validate_data_packet(longer), PacketError::kWrongSize);
+  auto flag = good;
+  flag[700] = 0xFE;  // block 7's flag
+  EXPECT_EQ(validate_data_packet(flag), PacketError::kBadBlockFlag);
+  auto azimuth = good;
+  azimuth[302] = 0x40;  // block 3 azimuth 0x9C40 = 40000
+  azimuth[303] = 0x9C;
+  EXPECT_EQ(validate_data_packet(azimuth), PacketError::kAzimuthOutOfRange);
+  auto mode = good;
+  mode[1204] = 0x3A;
+  EXPECT_EQ(validate_data_packet(mode), PacketError::kUnknownReturnMode);
+  const auto vlp32c = make_packet(0, 40, ReturnMode::kStrongest, 0x28);
+  EXPECT_EQ(validate_data_packet(vlp32c), PacketError::kUnsupportedProduct);
+  EXPECT_EQ(product_name(0x28), "VLP-32C");
+  // 0x21 passes validation: whether it is an early VLP-16 is decided from the timing.
+  EXPECT_EQ(validate_data_packet(make_packet(0, 40, ReturnMode::kStrongest, 0x21)), PacketError::kNone);
+  EXPECT_EQ(to_string(PacketError::kBadBlockFlag), "bad_block_flag");
+}
+
+TEST(Vlp16Decoder, StrongestModeGeometryAndTimingFollowTheManual) {
+  auto p = make_packet(1000, 40, ReturnMode::kStrongest);
+  set_return(p, 0, 0, 5000, 77);   // block 0, firing 0, laser 0 (−15°): 10 m
+  set_return(p, 3, 17, 2500, 12);  // block 3, firing 1, laser 1 (+1°): 5 m
+  const PacketDecoder decoder(Calibration::vlp16_default());
+  std::vector<Point> points;
+  const PacketDecoder::Result r = decoder.decode(p, points);
+  ASSERT_EQ(r.points, 2u);
+  EXPECT_EQ(r.no_return, 12u * 32u - 2u);
+
+  // Manual: x_m = R cos ω sin α, y_m = R cos ω cos α (y forward); REP-103: x = y_m, y = −x_m.
+  const Point& a = points[0];
+  const double alpha_a = 10.0 * kDeg;
+  EXPECT_NEAR(a.x, 10.0 * std::cos(-15 * kDeg) * std::cos(alpha_a), 1e-5);
+  EXPECT_NEAR(a.y, -10.0 * std::cos(-15 * kDeg) * std::sin(alpha_a), 1e-5);
+  EXPECT_NEAR(a.z, 10.0 * std::sin(-15 * kDeg) + 0.0112, 1e-5);
+  EXPECT_EQ(a.time_offset_ns, 0u);
+  EXPECT_EQ(a.intensity, 77);
+  EXPECT_EQ(a.laser, 0);
+  EXPECT_EQ(a.return_type, ReturnType::kStrongest);
+  EXPECT_FLOAT_EQ(a.distance_m, 10.0f);
+
+  // Block 3, second firing, laser 1: t = 3 · 110.592 + 55.296 + 2.304 µs; the azimuth moves
+  // 0.40° per block, so by (55.296 + 2.304) / 110.592 of it.
+  const Point& b = points[1];
+  const double t_us = 3 * 110.592 + 55.296 + 2.304;
+  EXPECT_EQ(b.time_offset_ns, static_cast<std::uint32_t>(std::lround(t_us * 1000)));
+  const double alpha_b_deg = 11.2 + 0.4 * (55.296 + 2.304) / 110.592;
+  EXPECT_NEAR(b.azimuth_deg, alpha_b_deg, 1e-4);
+  EXPECT_NEAR(b.x, 5.0 * std::cos(1 * kDeg) * std::cos(alpha_b_deg * kDeg), 1e-5);
+  EXPECT_NEAR(b.y, -5.0 * std::cos(1 * kDeg) * std::sin(alpha_b_deg * kDeg), 1e-5);
+  EXPECT_NEAR(b.z, 5.0 * std::sin(1 * kDeg) - 0.0007, 1e-5);
+  EXPECT_EQ(b.laser, 1);
+}
+
+TEST(Vlp16Decoder, AzimuthWrapsInsideAPacketAndLastBlockUsesThePreviousGap) {
+  auto p = make_packet(35900, 40, ReturnMode::kStrongest);  // blocks: 359.00, 359.40, 359.80, 0.20 …
+  set_return(p, 2, 16, 1000, 1);   // block 2 (359.80°), second firing: + 0.20° → 360.00 → 0.00
+  set_return(p, 11, 16, 1000, 1);  // last block: gap taken from blocks 10 → 11
+  const PacketDecoder decoder(Calibration::vlp16_default());
+  std::vector<Point> points;
+  decoder.decode(p, points);
+  ASSERT_EQ(points.size(), 2u);
+  EXPECT_NEAR(points[0].azimuth_deg, 0.0, 1e-4);
+  EXPECT_NEAR(points[0].y, 0.0, 1e-5);  // straight ahead
+  EXPECT_NEAR(points[1].azimuth_deg, (35900 + 40 * 11) % 36000 / 100.0 + 0.2, 1e-4);
+}
+
+TEST(Vlp16Decoder, LastReturnModeAndRangeLimits) {
+  auto p = make_packet(0, 40, ReturnMode::kLast);
+  set_return(p, 0, 0, 100, 1);    // 0.2 m
+  set_return(p, 0, 1, 1000, 1);   // 2 m
+  set_return(p, 0, 2, 60000, 1);  // 120 m
+  DecodeOptions options;
+  options.min_range_m = 0.3;
+  options.max_range_m = 100.0;
+  const PacketDecoder decoder(Calibration::vlp16_default(), options);
+  std::vector<Point> points;
+  const PacketDecoder::Result r = decoder.decode(p, points);
+  ASSERT_EQ(points.size(), 1u);
+  EXPECT_EQ(r.out_of_range, 2u);
+  EXPECT_EQ(points[0].return_type, ReturnType::kLast);
+  EXPECT_EQ(points[0].laser, 1);
+}
+
+TEST(Vlp16Decoder, DualReturnPairsShareTheFiringAndIdenticalReturnsGiveOnePoint) {
+  auto p = make_packet(2000, 40, ReturnMode::kDual);  // pairs (0,1), (2,3), …: 0.40° per pair
+  set_return(p, 0, 3, 1500, 10);  // last
+  set_return(p, 1, 3, 1500, 10);  // strongest, identical → one point
+  set_return(p, 2, 4, 2000, 20);  // last
+  set_return(p, 3, 4, 1800, 90);  // strongest, different → two points
+  set_return(p, 5, 6, 700, 50);   // only the strongest block has a return
+  const PacketDecoder decoder(Calibration::vlp16_default());
+  std::vector<Point> points;
+  decoder.decode(p, points);
+  ASSERT_EQ(points.size(), 4u);
+  EXPECT_EQ(points[0].return_type, ReturnType::kBoth);
+  EXPECT_FLOAT_EQ(points[0].distance_m, 3.0f);
+  EXPECT_EQ(points[1].return_type, ReturnType::kLast);
+  EXPECT_EQ(points[2].return_type, ReturnType::kStrongest);
+  EXPECT_EQ(points[1].time_offset_ns, points[2].time_offset_ns);  // one firing
+  EXPECT_EQ(points[1].azimuth_deg, points[2].azimuth_deg);
+  // pair 1 is the packet's second firing pair: 110.592 µs after pair 0
+  EXPECT_EQ(points[1].time_offset_ns, static_cast<std::uint32_t>(std::lround((110.592 + 4 * 2.304) * 1000)));
+  EXPECT_EQ(points[3].return_type, ReturnType::kStrongest);
+  EXPECT_EQ(points[3].intensity, 50);
+  EXPECT_EQ(points[3].time_offset_ns, static_cast<std::uint32_t>(std::lround((2 * 110.592 + 6 * 2.304) * 1000)));
+}
+
+}  // namespace
+}  // namespace trajroi::vlp16
