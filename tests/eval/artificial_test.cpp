@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 
 namespace trajroi::eval {
 namespace {
@@ -44,7 +45,7 @@ TEST(ArtificialScene, SizesAndTruthMatchTheSetUp) {
   const ArtificialScene curved = make_artificial_scene(ArtificialData::kCurved);
   EXPECT_EQ(curved.points.size(), 19'678u);
   EXPECT_EQ(std::count(curved.truth.begin(), curved.truth.end(), 1), 11'805);  // paper: 11,804
-  EXPECT_NEAR(curved.trajectory.length_m(), 25.0 * M_PI + 3.0, 1e-5);
+  EXPECT_NEAR(curved.trajectory.length_m(), 25.0 * std::numbers::pi + 3.0, 1e-5);
 }
 
 void expect_straight_rows_exact(RoiShape shape, std::span<const PaperRow> rows) {

@@ -103,6 +103,38 @@ INSTANTIATE_TEST_SUITE_P(AllShapes, FilterBehaviour,
                            return std::string("unknown");
                          });
 
+TEST(GridFilter, VectorScansApplyZLimitsLikeTheDoubleTest) {
+  // Limits that are not floats, and whose nearest floats lie outside them (−1.30000002 rounds
+  // down, 0.70000002 up): each path must admit exactly the float z values the double
+  // comparison admits, including the floats just either side of each limit.
+  const Trajectory t({V(0, 0), V(20, 0)});
+  std::vector<Centre> centres;
+  place_centres(t, 0.0, kInf, 1.0, centres);
+  const ZLimits z{-1.30000002, 0.70000002};
+  const CircularRoiSet set(2.0, centres, z);
+  std::vector<PointXYZI> points;
+  const float edges[] = {static_cast<float>(z.min_m), static_cast<float>(z.max_m)};
+  for (int i = 0; i < 64; ++i) {
+    const float edge = edges[i % 2];
+    const float towards = (i / 2) % 2 == 0 ? -kInf : kInf;
+    float value = edge;
+    for (int k = 0; k < (i / 4) % 3; ++k) value = std::nextafter(value, towards);
+    points.push_back({static_cast<float>(i % 20), 0.5f, value, 1.0f});
+  }
+  IndexVector ref;
+  const FilterStats ref_stats = reference_filter(set, std::span<const PointXYZI>(points), ref);
+  ASSERT_GT(ref.size(), 0u);
+  ASSERT_GT(ref_stats.outside_z, 0u);
+  GridFilter<CircularRoiSet> grid;
+  grid.build(set);
+  for (const SimdPath path : {SimdPath::kAvx2, SimdPath::kSse2, SimdPath::kScalar}) {
+    IndexVector fast;
+    const FilterStats stats = grid.filter(std::span<const PointXYZI>(points), fast, path);
+    EXPECT_EQ(fast, ref) << "path " << static_cast<int>(path);
+    EXPECT_EQ(stats.outside_z, ref_stats.outside_z) << "path " << static_cast<int>(path);
+  }
+}
+
 TEST(GridFilter, EmptyChainKeepsNothing) {
   const CircularRoiSet set(1.0, std::vector<Centre>{});
   GridFilter<CircularRoiSet> grid;

@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -48,7 +49,7 @@ Eigen::Isometry3d parse_pose(const std::string& text) {
       !std::isfinite(values[1]) || !std::isfinite(values[2])) {
     throw std::invalid_argument("--pose expects 'x_m,y_m,yaw_deg' with finite numbers, got '" + text + "'");
   }
-  return roi::pose_from_xy_yaw(values[0], values[1], values[2] * M_PI / 180.0);
+  return roi::pose_from_xy_yaw(values[0], values[1], values[2] * std::numbers::pi / 180.0);
 }
 
 double spacing(const FilterOptions& o, double size_along_m) {

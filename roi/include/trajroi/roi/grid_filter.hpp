@@ -32,6 +32,20 @@ enum class SimdPath : unsigned char { kAuto, kAvx2, kSse2, kScalar };
   return static_cast<double>(f) < v ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
 }
 
+// The z limits as the floats they admit, for the vector scans: for a float z,
+// z ≥ lo ⇔ (double) z ≥ z_min and z ≤ hi ⇔ (double) z ≤ z_max. `limited` is false when no
+// limit is set (then only finiteness is checked).
+struct FloatZLimits {
+  float lo;
+  float hi;
+  bool limited;
+};
+[[nodiscard]] inline FloatZLimits float_z_limits(const ZLimits& z) noexcept {
+  constexpr double kMax = std::numeric_limits<float>::max();
+  return {float_at_or_above(std::max(z.min_m, -kMax)), float_at_or_below(std::min(z.max_m, kMax)),
+          std::isfinite(z.min_m) || std::isfinite(z.max_m)};
+}
+
 // The fast filter: the same membership decision as reference_filter for every point, bit for
 // bit, at a per-point cost that does not grow with the number of ROIs.
 //
@@ -315,7 +329,7 @@ void GridFilter<RoiSet>::scalar_point(std::span<const Point> points, std::size_t
 template <typename RoiSet>
 template <typename Point>
 FilterStats GridFilter<RoiSet>::filter(std::span<const Point> points, IndexVector& kept,
-                                       SimdPath path) const {
+                                       [[maybe_unused]] SimdPath path) const {
   FilterStats stats;
   stats.input = points.size();
   kept.clear();
@@ -350,10 +364,10 @@ template <typename RoiSet>
 std::size_t GridFilter<RoiSet>::scan_sse2(std::span<const PointXYZI> points, Scan& scan) const {
   static_assert(sizeof(PointXYZI) == 16);
   if (points.size() < 4) return 0;
-  const ZLimits& z_limits = rois_->z_limits();
-  const bool z_limited = std::isfinite(z_limits.min_m) || std::isfinite(z_limits.max_m);
-  const __m128 lo = _mm_set1_ps(float_at_or_above(std::max(z_limits.min_m, -double{std::numeric_limits<float>::max()})));
-  const __m128 hi = _mm_set1_ps(float_at_or_below(std::min(z_limits.max_m, double{std::numeric_limits<float>::max()})));
+  const FloatZLimits z = float_z_limits(rois_->z_limits());
+  const bool z_limited = z.limited;
+  const __m128 lo = _mm_set1_ps(z.lo);
+  const __m128 hi = _mm_set1_ps(z.hi);
   const __m128 x0 = _mm_set1_ps(x0_);
   const __m128 y0 = _mm_set1_ps(y0_);
   const __m128 inv = _mm_set1_ps(inv_cell_);
@@ -522,18 +536,18 @@ template <typename RoiSet>
 __attribute__((target("avx2,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx2(
     std::span<const PointXYZI> points, Scan& scan) const {
   if (points.size() < 8) return 0;
-  const ZLimits& z_limits = rois_->z_limits();
+  const FloatZLimits z = float_z_limits(rois_->z_limits());
   const detail::Avx2Grid grid{
       _mm256_set1_ps(x0_),
       _mm256_set1_ps(y0_),
       _mm256_set1_ps(inv_cell_),
       _mm256_set1_ps(static_cast<float>(nx_)),
       _mm256_set1_ps(static_cast<float>(ny_)),
-      _mm256_set1_ps(float_at_or_above(std::max(z_limits.min_m, -double{std::numeric_limits<float>::max()}))),
-      _mm256_set1_ps(float_at_or_below(std::min(z_limits.max_m, double{std::numeric_limits<float>::max()}))),
+      _mm256_set1_ps(z.lo),
+      _mm256_set1_ps(z.hi),
       _mm256_set1_epi32(static_cast<std::int32_t>(nx_)),
       _mm256_set1_epi32(static_cast<std::int32_t>(cells_.size() - 1)),
-      std::isfinite(z_limits.min_m) || std::isfinite(z_limits.max_m),
+      z.limited,
       reinterpret_cast<const int*>(cells_.data())};
   const float* const base = &points.data()->x;
   std::uint32_t* const out = scan.out;
