@@ -1,83 +1,389 @@
-// Real third-party captures (../shared/data/velodyne, see its README), read through the pcap
-// source and decoded; figures checked against the counts the data README gives.
+// Real third-party captures (../shared/data/velodyne, see its README), replayed through the
+// pcap source and the stream decoder; content checked against independent references: the
+// data README's counts (made with a separate walker), MRPT's unit test, the GPRMC sentence,
+// and nebula's reference cloud.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <cstdio>
 #include <map>
+#include <set>
+#include <numbers>
 
+#include "pcd_reader.hpp"
 #include "test_data.hpp"
-#include "trajroi/vlp16/decoder.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
+#include "trajroi/vlp16/stream_decoder.hpp"
 
 namespace trajroi::vlp16 {
 namespace {
 
-struct CaptureSummary {
-  std::size_t data_packets = 0;      // port 2368, 1206 bytes
-  std::size_t position_packets = 0;  // port 8308, 512 bytes
-  std::map<PacketError, std::size_t> rejected;
-  std::map<std::uint8_t, std::size_t> products;
-  std::map<std::uint8_t, std::size_t> modes;
-  std::size_t points = 0;
-  std::size_t no_return = 0;
+struct Collector final : FrameSink {
+  std::vector<Frame> frames;
+  void on_frame(const Frame& frame) override { frames.push_back(frame); }
 };
 
-CaptureSummary read_capture(const std::filesystem::path& path) {
-  CaptureSummary s;
+struct Replay {
+  std::size_t data_datagrams = 0;
+  std::size_t position_datagrams = 0;
+  std::size_t wraps = 0;  // block azimuth decreasing from one block to the next
+  std::map<std::uint8_t, std::size_t> modes;
+  Collector frames;
+  StreamCounters counters;
+  std::string model_rejection;
+  std::optional<PositionPacket> first_rmc, last_rmc;
+};
+
+Replay replay(const std::filesystem::path& path, const Calibration& calibration = Calibration::vlp16_default(),
+              StreamOptions options = {}) {
+  Replay r;
   PcapSource source(path);
-  const PacketDecoder decoder(Calibration::vlp16_default());
-  std::vector<Point> points;
-  CapturedDatagram datagram{};
-  PcapSource::Next next;
-  while ((next = source.next(datagram)) == PcapSource::Next::kDatagram) {
-    if (datagram.payload.size() == 512) {
-      ++s.position_packets;
+  StreamDecoder decoder(calibration, options);
+  Datagram datagram;
+  PacketSource::Next next;
+  std::optional<std::uint16_t> last_azimuth;
+  while ((next = source.next(datagram)) == PacketSource::Next::kDatagram) {
+    if (datagram.destination_port == kPositionPort) {
+      ++r.position_datagrams;
+      decoder.on_position_packet(datagram.payload);
       continue;
     }
-    ++s.data_packets;
-    const PacketError error = validate_data_packet(datagram.payload);
-    if (error != PacketError::kNone) {
-      ++s.rejected[error];
-      continue;
+    ++r.data_datagrams;
+    if (validate_data_packet(datagram.payload) == PacketError::kNone) {
+      ++r.modes[return_mode_byte(datagram.payload)];
+      for (std::size_t block = 0; block < kBlocks; ++block) {
+        const std::uint16_t azimuth = block_azimuth(datagram.payload, block);
+        if (last_azimuth && azimuth < *last_azimuth) ++r.wraps;
+        last_azimuth = azimuth;
+      }
     }
-    ++s.products[product_id(datagram.payload)];
-    ++s.modes[return_mode_byte(datagram.payload)];
-    points.clear();
-    const PacketDecoder::Result r = decoder.decode(datagram.payload, points);
-    s.points += r.points;
-    s.no_return += r.no_return;
+    decoder.on_data_packet(datagram.payload, datagram.receive_time_ns, r.frames);
   }
-  EXPECT_EQ(next, PcapSource::Next::kEnd) << source.error();
-  return s;
+  EXPECT_EQ(next, PacketSource::Next::kEnd) << source.error();
+  decoder.flush(r.frames);
+  r.counters = decoder.counters();
+  r.model_rejection = decoder.model_rejection();
+  r.first_rmc = decoder.first_rmc();
+  r.last_rmc = decoder.last_rmc();
+  return r;
 }
 
-TEST(Vlp16Capture, MrptStrongestCaptureCountsMatchTheReadme) {
+std::int64_t utc_ns(int y, unsigned mo, unsigned d, int h, int mi, int s) {
+  namespace c = std::chrono;
+  const c::sys_days date{c::year{y} / c::month{mo} / c::day{d}};
+  return (c::duration_cast<c::nanoseconds>(date.time_since_epoch()) + c::hours{h} + c::minutes{mi} +
+          c::seconds{s})
+      .count();
+}
+
+TEST(Vlp16Capture, MrptStrongestCaptureMatchesTheReadmeAndMrptsScanCount) {
   TRAJROI_REQUIRE_DATA(path, "velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap");
-  const CaptureSummary s = read_capture(path);
-  EXPECT_EQ(s.data_packets, 293u);
-  EXPECT_EQ(s.position_packets, 57u);
-  EXPECT_TRUE(s.rejected.empty());
-  EXPECT_EQ(s.products.at(0x22), 293u);
-  EXPECT_EQ(s.modes.at(0x37), 293u);
-  // README: "73,486 of 112,512 channel returns are non-zero"; range limits are off.
-  EXPECT_EQ(s.points, 73'486u);
-  EXPECT_EQ(s.points + s.no_return, 112'512u);
+  const Replay r = replay(path);
+  EXPECT_EQ(r.data_datagrams, 293u);
+  EXPECT_EQ(r.position_datagrams, 57u);
+  EXPECT_EQ(r.counters.decoded_packets, 293u);
+  EXPECT_EQ(r.counters.rejected_total(), 0u);
+  EXPECT_EQ(r.modes.at(0x37), 293u);
+  // README: 73,486 of the 112,512 channel returns are non-zero; range limits are off.
+  EXPECT_EQ(r.counters.points, 73'486u);
+  EXPECT_EQ(r.counters.points + r.counters.no_return, 293u * 384u);
+  EXPECT_EQ(r.counters.lost_packets, 0u);
+  EXPECT_EQ(r.counters.out_of_order, 0u);
+
+  // MRPT's unit test counts 4 scans (azimuth wraps): between the first and the last partial
+  // sweeps lie wraps − 1 whole ones.
+  EXPECT_EQ(r.wraps, 4u);
+  EXPECT_EQ(r.counters.frames, r.wraps - 1);
+  EXPECT_EQ(r.counters.partial_frames, 2u);
+  ASSERT_EQ(r.frames.frames.size(), r.wraps + 1);
+  std::size_t points_in_frames = 0;
+  for (const Frame& f : r.frames.frames) {
+    points_in_frames += f.points.size();
+    EXPECT_EQ(f.return_mode, ReturnMode::kStrongest);
+    EXPECT_EQ(f.lost_packets, 0u);
+  }
+  EXPECT_EQ(points_in_frames, r.counters.points);
+  for (std::size_t i = 1; i + 1 < r.frames.frames.size(); ++i) {
+    const Frame& f = r.frames.frames[i];
+    EXPECT_FALSE(f.partial);
+    // A whole sweep at ~10 Hz: ~75 packets, ~0.1 s, azimuths from the cut (0°) round to it.
+    EXPECT_NEAR(static_cast<double>(f.packets), 75.0, 3.0);
+    EXPECT_NEAR(static_cast<double>(f.end_time_ns - f.start_time_ns) * 1e-9, 0.1, 0.005);
+    EXPECT_LT(f.points.front().azimuth_deg, 1.0f);
+    EXPECT_GT(f.points.back().azimuth_deg, 359.0f);
+    EXPECT_EQ(f.points.front().time_offset_ns, 0u);
+    ASSERT_TRUE(f.start_utc_ns.has_value());
+    // The sweeps lie in 2016-01-21 08:18:02–04 UTC, the GPRMC's second and after.
+    EXPECT_GE(*f.start_utc_ns, utc_ns(2016, 1, 21, 8, 18, 2));
+    EXPECT_LT(*f.start_utc_ns, utc_ns(2016, 1, 21, 8, 18, 5));
+  }
+  EXPECT_TRUE(r.frames.frames.front().partial);
+  EXPECT_TRUE(r.frames.frames.back().partial);
+
+  // $GPRMC,081802.00,A,3649.7478558,N,00224.4542928,W,0.034,212.5,210116,0.0,E,A*2E
+  EXPECT_EQ(r.counters.nmea[static_cast<std::size_t>(NmeaError::kNone)], 57u);
+  ASSERT_TRUE(r.first_rmc.has_value());
+  EXPECT_EQ(r.first_rmc->pps, PpsStatus::kLocked);
+  EXPECT_TRUE(r.first_rmc->rmc.valid);
+  EXPECT_EQ(r.first_rmc->rmc.utc_ns, utc_ns(2016, 1, 21, 8, 18, 2));
+  EXPECT_DOUBLE_EQ(r.first_rmc->rmc.latitude_deg, 36.0 + 49.7478558 / 60.0);
+  EXPECT_DOUBLE_EQ(r.first_rmc->rmc.longitude_deg, -(2.0 + 24.4542928 / 60.0));
+  ASSERT_TRUE(r.last_rmc.has_value());
+  EXPECT_GE(r.last_rmc->rmc.utc_ns, r.first_rmc->rmc.utc_ns);
 }
 
-TEST(Vlp16Capture, NebulaDualCaptureIsDualVlp16) {
-  TRAJROI_REQUIRE_DATA(path, "velodyne/vlp16/nebula_vlp16_dual_1673400471.DERIVED.pcap");
-  const CaptureSummary s = read_capture(path);
-  EXPECT_EQ(s.data_packets, 603u);
-  EXPECT_EQ(s.modes.at(0x39), 603u);
-  EXPECT_EQ(s.products.at(0x22), 603u);
-  EXPECT_GT(s.points, 14'831u);  // nebula's cloud of one scan is a subset of the capture
+TEST(Vlp16Capture, EarlyFirmwareProductId0x21WithVlp16TimingDecodesAsVlp16) {
+  TRAJROI_REQUIRE_DATA(path, "velodyne/vlp16/rust-lidar-utils_velodyne_vlp16_2014_productid0x21.pcap");
+  const Replay r = replay(path);
+  EXPECT_EQ(r.data_datagrams, 84u);
+  EXPECT_EQ(r.position_datagrams, 16u);
+  EXPECT_EQ(r.counters.rejected_total(), 0u) << r.model_rejection;
+  EXPECT_EQ(r.counters.decoded_packets, 84u);  // the held first packet included
+  EXPECT_GT(r.counters.points, 0u);
+  EXPECT_EQ(r.counters.lost_packets, 0u);
+  EXPECT_EQ(r.wraps, 1u);
+  EXPECT_EQ(r.counters.frames, 0u);  // 1 wrap: two partial sweeps
+  EXPECT_EQ(r.counters.partial_frames, 2u);
+  // Position packets with PPS 0 and no NMEA: no RMC, no UTC.
+  EXPECT_EQ(r.counters.nmea[static_cast<std::size_t>(NmeaError::kEmpty)], 16u);
+  EXPECT_FALSE(r.first_rmc.has_value());
+  EXPECT_FALSE(r.frames.frames.front().start_utc_ns.has_value());
 }
 
-TEST(Vlp16Capture, Vlp32cCaptureIsRejectedByProductId) {
-  TRAJROI_REQUIRE_DATA(path, "velodyne/other_models/nebula_vlp32c_strongest_1713492677.DERIVED.pcap");
-  const CaptureSummary s = read_capture(path);
-  EXPECT_EQ(s.data_packets, 379u);
-  EXPECT_EQ(s.rejected.at(PacketError::kUnsupportedProduct), 379u);
-  EXPECT_EQ(s.points, 0u);
+TEST(Vlp16Capture, Vlp16Example2018Decodes) {
+  TRAJROI_REQUIRE_DATA(path, "velodyne/vlp16/rust-lidar-utils_velodyne_example_2018.pcap");
+  const Replay r = replay(path);
+  EXPECT_EQ(r.data_datagrams, 84u);
+  EXPECT_EQ(r.counters.decoded_packets, 84u);
+  EXPECT_EQ(r.counters.lost_packets, 0u);
+}
+
+struct RejectedCapture {
+  const char* file;
+  std::size_t data_packets;
+  const char* reason;
+};
+
+class Vlp16RejectsOtherModels : public testing::TestWithParam<RejectedCapture> {};
+
+TEST_P(Vlp16RejectsOtherModels, EveryPacketRejectedWithTheReason) {
+  TRAJROI_REQUIRE_DATA(path, GetParam().file);
+  const Replay r = replay(path);
+  EXPECT_EQ(r.data_datagrams, GetParam().data_packets);
+  EXPECT_EQ(r.counters.rejected[static_cast<std::size_t>(PacketError::kUnsupportedProduct)],
+            GetParam().data_packets);
+  EXPECT_EQ(r.counters.decoded_packets, 0u);
+  EXPECT_EQ(r.counters.points, 0u);
+  EXPECT_TRUE(r.frames.frames.empty());
+  EXPECT_NE(r.model_rejection.find(GetParam().reason), std::string::npos) << r.model_rejection;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Captures, Vlp16RejectsOtherModels,
+    testing::Values(
+        RejectedCapture{"velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap", 500,
+                        "product id 0x21 (HDL-32E) is not supported: 553 µs between packets"},
+        RejectedCapture{"velodyne/other_models/rust-lidar-utils_velodyne_vlp32_ACTUALLY_HDL-32E.pcap", 91,
+                        "product id 0x21 (HDL-32E) is not supported"},
+        RejectedCapture{"velodyne/other_models/nebula_vlp32c_strongest_1713492677.DERIVED.pcap", 379,
+                        "product id 0x28 (VLP-32C) is not supported"}));
+
+// nebula's return types (nebula_common.hpp): IDENTICAL 6 when the pair's returns are equal
+// or the other one is empty; otherwise FIRST_* (4, 9) for the farther return, which is the
+// last one, and LAST_* (5, 10) for the nearer, the strongest that is not the last.
+bool same_return(std::uint32_t nebula, ReturnType ours) {
+  switch (nebula) {
+    case 6: return true;  // kBoth, or a kLast / kStrongest whose partner was empty
+    case 4:
+    case 9: return ours == ReturnType::kLast;
+    case 5:
+    case 10: return ours == ReturnType::kStrongest;
+    default: return false;
+  }
+}
+
+// nebula's reference cloud of one dual-return sweep (14,831 points), made by its VLP-16
+// decoder with the calibration YAML, min range 0.3 m. Every reference point must be one of
+// ours: same ring ("channel"), same raw distance, intensity and return, a time consistent
+// with nebula's time_stamp (ns since its scan start), and the same position within 1 mm.
+//
+// Azimuth: nebula rounds the interpolated azimuth to 0.01°, and for some firings it does
+// not interpolate (its azimuth step is 0 for the last block pair of a dual packet, and its
+// odd blocks take the next pair's azimuth). Its `azimuth` field says which azimuth it used.
+// Where that equals ours (to its 0.01° rounding), our x/y/z are compared directly; where it
+// does not, our point is first turned about z by the azimuth difference, which compares
+// range, elevation and calibration with nebula's and leaves out only its interpolation.
+TEST(Vlp16Capture, NebulaDualReturnReferenceCloudIsReproducedPointForPoint) {
+  TRAJROI_REQUIRE_DATA(capture, "velodyne/vlp16/nebula_vlp16_dual_1673400471.DERIVED.pcap");
+  TRAJROI_REQUIRE_DATA(yaml, "velodyne/vlp16/nebula_VLP16_calibration.yaml");
+  TRAJROI_REQUIRE_DATA(pcd, "velodyne/vlp16/nebula_vlp16_dual_reference_1673400472138016708.pcd");
+  const Calibration calibration = parse_calibration_yaml(test::read_file(yaml), yaml.string());
+  StreamOptions options;
+  options.decode.min_range_m = 0.3;  // nebula's test parameters
+  options.decode.max_range_m = 300.0;
+  const Replay r = replay(capture, calibration, options);
+  EXPECT_EQ(r.data_datagrams, 603u);
+  EXPECT_EQ(r.modes.at(0x39), 603u);
+  EXPECT_EQ(r.counters.lost_packets, 0u);
+  EXPECT_EQ(r.wraps, 4u);
+  EXPECT_EQ(r.counters.frames + r.counters.partial_frames, r.wraps + 1);
+
+  const test::PcdCloud reference = test::read_pcd(pcd);
+  ASSERT_EQ(reference.points(), 14'831u);
+  const auto x = reference.floats("x"), y = reference.floats("y"), z = reference.floats("z");
+  const auto azimuth_rad = reference.floats("azimuth");
+  const auto distance = reference.floats("distance");
+  const auto channel = reference.unsigneds("channel");
+  const auto type = reference.unsigneds("return_type");
+  const auto intensity = reference.unsigneds("intensity");
+  const auto time = reference.unsigneds("time_stamp");
+
+  // Our points by (ring, raw distance), with the frame they are in.
+  struct Ours {
+    const Point* point;
+    std::size_t frame;
+  };
+  std::multimap<std::pair<std::uint32_t, long>, Ours> ours;
+  for (std::size_t f = 0; f < r.frames.frames.size(); ++f) {
+    for (const Point& p : r.frames.frames[f].points) {
+      ours.emplace(std::pair{std::uint32_t{p.ring}, std::lround(double{p.distance_m} / 0.002)}, Ours{&p, f});
+    }
+  }
+  const auto nebula_azimuth_deg = [&](std::size_t i) { return double{azimuth_rad[i]} * 180.0 / std::numbers::pi; };
+  const auto azimuth_step = [](double from_deg, double to_deg) {
+    double d = to_deg - from_deg;
+    if (d > 180.0) d -= 360.0;
+    if (d < -180.0) d += 360.0;
+    return d;
+  };
+  // Our point for reference point i in frame `frame` (any frame if none): same ring, raw
+  // distance, intensity and return, not yet matched, nearest in azimuth and within 1°
+  // (nebula's azimuth can be a whole firing step, 0.4–0.6° here, from the true one).
+  std::set<const Point*> used;  // each of our points stands for one reference point
+  const auto find = [&](std::size_t i, std::optional<std::size_t> frame) -> const Ours* {
+    const Ours* best = nullptr;
+    double best_step = 1.0;
+    const auto [begin, end] = ours.equal_range({channel[i], std::lround(double{distance[i]} / 0.002)});
+    for (auto it = begin; it != end; ++it) {
+      const Point& p = *it->second.point;
+      if ((frame && it->second.frame != *frame) || p.intensity != intensity[i] ||
+          !same_return(type[i], p.return_type) || used.count(&p) != 0) {
+        continue;
+      }
+      const double step = std::abs(azimuth_step(double{p.azimuth_deg}, nebula_azimuth_deg(i)));
+      if (step <= best_step) {
+        best_step = step;
+        best = &it->second;
+      }
+    }
+    return best;
+  };
+  // A static scene repeats every rotation: first find which of our sweeps nebula's is.
+  std::map<std::size_t, std::size_t> votes;
+  for (std::size_t i = 0; i < reference.points(); ++i) {
+    if (const Ours* o = find(i, std::nullopt)) ++votes[o->frame];
+  }
+  ASSERT_FALSE(votes.empty());
+  const std::size_t frame = std::max_element(votes.begin(), votes.end(), [](auto& a, auto& b) {
+                              return a.second < b.second;
+                            })->first;
+
+  // nebula's stamps come from a double of Unix seconds (≈ 240 ns steps): allow 0.5 µs.
+  constexpr std::int64_t kTimeTolerance_ns = 500;
+  std::optional<std::int64_t> previous_residual;
+  std::size_t time_jumps = 0;
+  std::size_t direct = 0, turned = 0, missing_points = 0;
+  double worst_direct_m = 0.0, worst_turned_m = 0.0, worst_turn_deg = 0.0;
+  for (std::size_t i = 0; i < reference.points(); ++i) {
+    const Ours* match = find(i, frame);
+    if (match == nullptr) {
+      if (++missing_points <= 10) {
+        ADD_FAILURE() << "nebula point " << i << " (channel " << channel[i] << ", d " << distance[i] << ") has no match";
+      }
+      continue;
+    }
+    const Point& p = *match->point;
+    used.insert(&p);
+    // Time: nebula stamps each point from its packet's receive time and, in dual mode,
+    // advances its firing schedule by block (2 × 110.592 µs per firing pair) where the sensor
+    // fires once per pair; ours follow the sensor's clock and schedule. Within one firing
+    // pair both advance by the same laser and sequence offsets (2.304, 55.296 µs), so the
+    // difference is constant there and changes only between pairs and packets.
+    const std::int64_t residual = static_cast<std::int64_t>(time[i]) - std::int64_t{p.time_offset_ns};
+    if (previous_residual && std::llabs(residual - *previous_residual) > kTimeTolerance_ns) ++time_jumps;
+    previous_residual = residual;
+    const double turn_deg = azimuth_step(double{p.azimuth_deg}, nebula_azimuth_deg(i));
+    double px = p.x, py = p.y;
+    const bool interpolated_alike = std::abs(turn_deg) <= 0.0051;  // nebula's 0.01° rounding
+    if (!interpolated_alike) {  // turn our point to nebula's azimuth (clockwise from x)
+      const double c = std::cos(turn_deg * std::numbers::pi / 180.0), s = std::sin(turn_deg * std::numbers::pi / 180.0);
+      px = c * double{p.x} + s * double{p.y};
+      py = -s * double{p.x} + c * double{p.y};
+      worst_turn_deg = std::max(worst_turn_deg, std::abs(turn_deg));
+    }
+    const double error = std::max({std::abs(px - double{x[i]}), std::abs(py - double{y[i]}),
+                                   std::abs(double{p.z} - double{z[i]})});
+    EXPECT_LE(error, 1e-3) << "nebula point " << i << ", azimuth turned by " << turn_deg << "°";
+    if (interpolated_alike) {
+      ++direct;
+      worst_direct_m = std::max(worst_direct_m, error);
+    } else {
+      ++turned;
+      worst_turned_m = std::max(worst_turned_m, error);
+    }
+  }
+  EXPECT_EQ(missing_points, 0u);
+  EXPECT_EQ(direct + turned, reference.points());
+  // Most firings nebula interpolates as we do; the others differ by less than one firing's
+  // azimuth step.
+  EXPECT_GT(direct, reference.points() * 8 / 10);
+  // At most one change of the time difference per firing pair (6 a packet) and packet;
+  // wrong laser or sequence offsets would change it between nearly every pair of points.
+  const std::size_t packets = r.frames.frames[frame].packets;
+  EXPECT_LE(time_jumps, packets * 7) << "per-point times not consistent with nebula's";
+  EXPECT_LT(time_jumps, reference.points() / 10) << "per-point times not consistent with nebula's";
+  RecordProperty("direct_points", std::to_string(direct));
+  RecordProperty("turned_points", std::to_string(turned));
+  RecordProperty("worst_direct_error_m", std::to_string(worst_direct_m));
+  RecordProperty("worst_turned_error_m", std::to_string(worst_turned_m));
+  RecordProperty("time_base_changes", std::to_string(time_jumps));
+  std::printf("nebula reference: %zu points direct (worst %.2e m), %zu turned by up to %.3f deg (worst %.2e m), "
+              "%zu time base changes over %u packets\n",
+              direct, worst_direct_m, turned, worst_turn_deg, worst_turned_m, time_jumps,
+              r.frames.frames[frame].packets);
+}
+
+// A capture cut inside a record: every whole record before the cut is delivered, then an
+// error that says so.
+TEST(Vlp16Capture, TruncatedCaptureDeliversEveryWholeRecordThenAnError) {
+  TRAJROI_REQUIRE_DATA(path, "velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap");
+  const std::string bytes = test::read_file(path);
+  // Walk the record headers (24-byte file header, 16-byte record headers) to find where the
+  // 100th record ends, and cut 500 bytes into the 101st.
+  std::size_t at = 24;
+  for (int record = 0; record < 100; ++record) {
+    std::uint32_t captured = 0;
+    std::memcpy(&captured, bytes.data() + at + 8, 4);
+    at += 16 + captured;
+  }
+  const auto cut = std::filesystem::path(testing::TempDir()) / "trajroi_truncated.pcap";
+  {
+    std::ofstream out(cut, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(at + 500));
+  }
+  PcapSource source(cut);
+  Datagram datagram;
+  std::size_t delivered = 0;
+  PacketSource::Next next;
+  while ((next = source.next(datagram)) == PacketSource::Next::kDatagram) ++delivered;
+  EXPECT_EQ(delivered, 100u);
+  EXPECT_EQ(next, PacketSource::Next::kError);
+  EXPECT_NE(source.error().find("truncated"), std::string::npos) << source.error();
+  std::filesystem::remove(cut);
 }
 
 TEST(Vlp16Capture, UnreadableFileIsAClearError) {

@@ -85,11 +85,15 @@ TEST(Vlp16Decoder, StrongestModeGeometryAndTimingFollowTheManual) {
   EXPECT_EQ(r.no_return, 12u * 32u - 2u);
 
   // Manual: x_m = R cos ω sin α, y_m = R cos ω cos α (y forward); REP-103: x = y_m, y = −x_m.
+  // The laser's vertical offset v moves the origin along the beam's normal (velodyne model):
+  // r_xy = R cos ω − v sin ω, z = R sin ω + v cos ω.
   const Point& a = points[0];
   const double alpha_a = 10.0 * kDeg;
-  EXPECT_NEAR(a.x, 10.0 * std::cos(-15 * kDeg) * std::cos(alpha_a), 1e-5);
-  EXPECT_NEAR(a.y, -10.0 * std::cos(-15 * kDeg) * std::sin(alpha_a), 1e-5);
-  EXPECT_NEAR(a.z, 10.0 * std::sin(-15 * kDeg) + 0.0112, 1e-5);
+  const double r_xy_a = 10.0 * std::cos(-15 * kDeg) - 0.0112 * std::sin(-15 * kDeg);
+  EXPECT_NEAR(a.x, r_xy_a * std::cos(alpha_a), 1e-5);
+  EXPECT_NEAR(a.y, -r_xy_a * std::sin(alpha_a), 1e-5);
+  EXPECT_NEAR(a.z, 10.0 * std::sin(-15 * kDeg) + 0.0112 * std::cos(-15 * kDeg), 1e-5);
+  EXPECT_EQ(a.ring, 0);  // −15°: the lowest
   EXPECT_EQ(a.time_offset_ns, 0u);
   EXPECT_EQ(a.intensity, 77);
   EXPECT_EQ(a.laser, 0);
@@ -103,10 +107,12 @@ TEST(Vlp16Decoder, StrongestModeGeometryAndTimingFollowTheManual) {
   EXPECT_EQ(b.time_offset_ns, static_cast<std::uint32_t>(std::lround(t_us * 1000)));
   const double alpha_b_deg = 11.2 + 0.4 * (55.296 + 2.304) / 110.592;
   EXPECT_NEAR(b.azimuth_deg, alpha_b_deg, 1e-4);
-  EXPECT_NEAR(b.x, 5.0 * std::cos(1 * kDeg) * std::cos(alpha_b_deg * kDeg), 1e-5);
-  EXPECT_NEAR(b.y, -5.0 * std::cos(1 * kDeg) * std::sin(alpha_b_deg * kDeg), 1e-5);
-  EXPECT_NEAR(b.z, 5.0 * std::sin(1 * kDeg) - 0.0007, 1e-5);
+  const double r_xy_b = 5.0 * std::cos(1 * kDeg) + 0.0007 * std::sin(1 * kDeg);
+  EXPECT_NEAR(b.x, r_xy_b * std::cos(alpha_b_deg * kDeg), 1e-5);
+  EXPECT_NEAR(b.y, -r_xy_b * std::sin(alpha_b_deg * kDeg), 1e-5);
+  EXPECT_NEAR(b.z, 5.0 * std::sin(1 * kDeg) - 0.0007 * std::cos(1 * kDeg), 1e-5);
   EXPECT_EQ(b.laser, 1);
+  EXPECT_EQ(b.ring, 8);  // +1°: above the eight lasers −15 … −1°
 }
 
 TEST(Vlp16Decoder, AzimuthWrapsInsideAPacketAndLastBlockUsesThePreviousGap) {

@@ -2,7 +2,10 @@
 
 #include <pcap/pcap.h>
 
+#include <algorithm>
 #include <stdexcept>
+#include <thread>
+#include <utility>
 
 namespace trajroi::vlp16 {
 namespace {
@@ -55,7 +58,11 @@ struct PcapSource::Handle {
   }
 };
 
-PcapSource::PcapSource(const std::filesystem::path& path) : handle_(std::make_unique<Handle>()) {
+PcapSource::PcapSource(const std::filesystem::path& path, PcapOptions options)
+    : handle_(std::make_unique<Handle>()), options_(std::move(options)) {
+  if (!(options_.speed >= 0.0)) {
+    throw std::invalid_argument(path.string() + ": replay speed must be 0 (as fast as possible) or positive");
+  }
   char message[PCAP_ERRBUF_SIZE] = {};
   handle_->pcap = pcap_open_offline_with_tstamp_precision(path.c_str(), PCAP_TSTAMP_PRECISION_NANO, message);
   if (handle_->pcap == nullptr) {
@@ -70,7 +77,35 @@ PcapSource::PcapSource(const std::filesystem::path& path) : handle_(std::make_un
 
 PcapSource::~PcapSource() = default;
 
-PcapSource::Next PcapSource::next(CapturedDatagram& datagram) {
+PcapSource::Next PcapSource::next(Datagram& datagram, std::chrono::milliseconds timeout) {
+  if (!pending_) {
+    const Next next = read(pending_datagram_);
+    if (next != Next::kDatagram) return next;
+    pending_ = true;
+  }
+  if (options_.speed > 0.0) {
+    const auto now = std::chrono::steady_clock::now();
+    if (!paced_start_) {
+      paced_start_ = true;
+      first_record_ns_ = pending_datagram_.receive_time_ns;
+      first_delivery_ = now;
+    }
+    const auto offset_ns = static_cast<double>(pending_datagram_.receive_time_ns - first_record_ns_) / options_.speed;
+    const auto due = first_delivery_ + std::chrono::nanoseconds(static_cast<std::int64_t>(std::max(0.0, offset_ns)));
+    if (due > now) {
+      if (timeout != std::chrono::milliseconds::max() && due - now > timeout) {
+        std::this_thread::sleep_for(timeout);
+        return Next::kTimeout;
+      }
+      std::this_thread::sleep_until(due);
+    }
+  }
+  pending_ = false;
+  datagram = pending_datagram_;
+  return Next::kDatagram;
+}
+
+PcapSource::Next PcapSource::read(Datagram& datagram) {
   while (true) {
     pcap_pkthdr* header = nullptr;
     const std::uint8_t* frame = nullptr;
@@ -103,9 +138,14 @@ PcapSource::Next PcapSource::next(CapturedDatagram& datagram) {
       ++skipped_;
       continue;
     }
+    const std::uint16_t port = be16(frame + udp + 2);
+    if (std::find(options_.ports.begin(), options_.ports.end(), port) == options_.ports.end()) {
+      ++skipped_;
+      continue;
+    }
     datagram.payload = std::span<const std::uint8_t>(frame + udp + 8, udp_length - 8);
-    datagram.destination_port = be16(frame + udp + 2);
-    datagram.capture_time_ns = static_cast<std::int64_t>(header->ts.tv_sec) * 1'000'000'000 +
+    datagram.destination_port = port;
+    datagram.receive_time_ns = static_cast<std::int64_t>(header->ts.tv_sec) * 1'000'000'000 +
                                static_cast<std::int64_t>(header->ts.tv_usec);  // ns precision
     return Next::kDatagram;
   }

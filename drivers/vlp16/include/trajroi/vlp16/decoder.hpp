@@ -2,15 +2,20 @@
 
 // Decoding of VLP-16 data packets into points in the sensor frame.
 //
-// Sensor frame (REP-103): x forward (azimuth 0), y left, z up, metres. The VLP-16 azimuth α
-// grows clockwise seen from above, so with ω the laser's vertical angle and R the range:
-//   x = R cos ω cos α,   y = −R cos ω sin α,   z = R sin ω + vertical offset.
-// (The manual's own frame has y forward: x_m = R cos ω sin α, y_m = R cos ω cos α.)
+// Sensor frame (REP-103): x forward (azimuth 0), y left, z up, metres. The VLP-16 azimuth
+// grows clockwise seen from above. With ω the laser's vertical angle, R the corrected range,
+// θ = azimuth − rot_correction, v and h the laser's vertical and horizontal offsets, this is
+// the calibration model of the velodyne/nebula drivers (whose calibration files we read):
+//   r_xy = R cos ω − v sin ω
+//   x = r_xy cos θ + h sin θ,   y = −r_xy sin θ + h cos θ,   z = R sin ω + v cos ω.
+// With v = h = 0 this is the VLP-16 manual's x_m = R cos ω sin α, y_m = R cos ω cos α (manual
+// frame: y forward) turned into REP-103 (x = y_m, y = −x_m).
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "trajroi/vlp16/packet.hpp"
@@ -19,11 +24,11 @@ namespace trajroi::vlp16 {
 
 // One laser's geometry, as in the velodyne/nebula calibration files (angles in radians).
 struct LaserCalibration {
-  double vert_angle_rad = 0.0;        // ω
-  double rot_correction_rad = 0.0;    // added to the azimuth
-  double vert_offset_m = 0.0;         // added to z
-  double horiz_offset_m = 0.0;        // not used by the VLP-16 (0 in its calibrations)
-  double dist_correction_m = 0.0;     // added to the range
+  double vert_angle_rad = 0.0;      // ω
+  double rot_correction_rad = 0.0;  // subtracted from the azimuth
+  double vert_offset_m = 0.0;       // v
+  double horiz_offset_m = 0.0;      // h
+  double dist_correction_m = 0.0;   // added to the range
 };
 
 // Geometry of the 16 lasers, indexed by laser channel (firing order 0 … 15).
@@ -32,22 +37,33 @@ struct Calibration {
   // The VLP-16 manual's values: vertical angles −15, 1, −13, 3, … , −1, 15° in firing order,
   // and its vertical offset corrections (11.2 mm … −11.2 mm).
   [[nodiscard]] static Calibration vlp16_default();
+  // The rank of each laser by vertical angle (0 = lowest): the "ring" of point clouds.
+  [[nodiscard]] std::array<std::uint8_t, kLasers> rings() const;
 };
+
+// Reads the velodyne/nebula calibration YAML (`lasers: [{laser_id, vert_correction,
+// rot_correction, vert_offset_correction, horiz_offset_correction, dist_correction, …}]`,
+// angles in radians, lengths in metres). Exactly the 16 laser ids 0 … 15 must appear.
+// Throws std::runtime_error naming `source`, the laser and the key on any problem.
+[[nodiscard]] Calibration parse_calibration_yaml(std::string_view text, std::string_view source);
 
 // Which return of a dual-return pair a point is. In dual mode each firing fills a block pair:
 // the even block holds the last return, the odd block the strongest (or, when the strongest
 // is the last, the second strongest). Identical returns give one point, kBoth.
 enum class ReturnType : std::uint8_t { kStrongest = 1, kLast = 2, kBoth = 3 };
+[[nodiscard]] std::string_view to_string(ReturnType type) noexcept;
 
 struct Point {
-  float x;                      // sensor frame, m
+  float x;                       // sensor frame, m
   float y;
   float z;
-  float distance_m;             // corrected range
-  float azimuth_deg;            // interpolated firing azimuth, [0, 360)
-  std::uint32_t time_offset_ns; // after the packet's timestamp (first firing of block 0)
-  std::uint8_t intensity;       // calibrated reflectivity
-  std::uint8_t laser;           // laser channel 0 … 15 (firing order)
+  float distance_m;              // corrected range
+  float azimuth_deg;             // interpolated firing azimuth, [0, 360), before rot_correction
+  std::uint32_t time_offset_ns;  // after the packet's first firing (its timestamp); in a
+                                 // Frame, after the frame's start instead
+  std::uint8_t intensity;        // calibrated reflectivity
+  std::uint8_t laser;            // laser channel 0 … 15 (firing order)
+  std::uint8_t ring;             // rank by vertical angle, 0 = lowest
   ReturnType return_type;
 };
 
@@ -64,6 +80,8 @@ class PacketDecoder {
     std::size_t points = 0;        // appended to `out`
     std::size_t no_return = 0;     // zero distance
     std::size_t out_of_range = 0;  // outside [min_range, max_range]
+    std::size_t merged_returns = 0;  // dual mode: second returns identical to the first
+    // points + no_return + out_of_range + merged_returns = 384 per packet
   };
 
   // Appends the points of one packet that validate_data_packet() accepted. Never reads
@@ -71,10 +89,21 @@ class PacketDecoder {
   Result decode(std::span<const std::uint8_t> packet, std::vector<Point>& out) const;
 
  private:
+  struct Laser {
+    double cos_vert, sin_vert;
+    double cos_rot, sin_rot;
+    double vert_offset_m, horiz_offset_m, dist_correction_m;
+    std::uint8_t ring;
+  };
   DecodeOptions options_;
-  std::array<LaserCalibration, kLasers> lasers_;
-  std::array<double, kLasers> cos_vert_;
-  std::array<double, kLasers> sin_vert_;
+  std::array<Laser, kLasers> lasers_{};
+  bool rotation_corrected_ = false;  // some rot_correction ≠ 0
+  // Per channel 0 … 31 of a block: its firing time after the block's first, as a fraction of
+  // the block's duration (for azimuth interpolation).
+  std::array<double, kFiringsPerBlock * kLasers> azimuth_fraction_{};
+  // Per firing pair (12 in single mode, 6 in dual) and channel: ns after the packet's first
+  // firing, rounded once here.
+  std::array<std::array<std::uint32_t, kFiringsPerBlock * kLasers>, kBlocks> time_ns_{};
 };
 
 }  // namespace trajroi::vlp16

@@ -23,6 +23,7 @@ inline constexpr std::uint16_t kAzimuthLimit = 36000; // hundredths of a degree
 inline constexpr double kDistanceUnit_m = 0.002;
 inline constexpr double kLaserPeriod_us = 2.304;      // between two lasers of one firing
 inline constexpr double kFiringCycle_us = 55.296;     // one firing sequence, recharge included
+inline constexpr std::int64_t kHour_us = 3'600'000'000;  // timestamps count µs past the hour
 
 enum class ReturnMode : std::uint8_t { kStrongest = 0x37, kLast = 0x38, kDual = 0x39 };
 inline constexpr std::uint8_t kProductVlp16 = 0x22;
@@ -69,6 +70,12 @@ inline constexpr std::size_t kPacketErrorCount = 6;
 }
 [[nodiscard]] inline std::uint8_t product_id(std::span<const std::uint8_t> p) noexcept {
   return p[kProductIdOffset];
+}
+
+// `to − from` for two top-of-hour timestamps, across the hour wrap: in [−½ h, ½ h).
+[[nodiscard]] inline std::int64_t toh_delta_us(std::uint32_t from, std::uint32_t to) noexcept {
+  const std::int64_t delta = (static_cast<std::int64_t>(to) - from + kHour_us + kHour_us / 2) % kHour_us;
+  return delta - kHour_us / 2;
 }
 
 // Checks size, every block flag and azimuth, the return mode and the product id. Product

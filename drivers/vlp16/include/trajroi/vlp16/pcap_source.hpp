@@ -2,48 +2,59 @@
 
 // Reading Velodyne UDP payloads from a pcap capture (libpcap). An I/O adapter: kept out of
 // the pure decoder's target.
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
-#include <span>
 #include <string>
+#include <vector>
+
+#include "trajroi/vlp16/packet_source.hpp"
 
 namespace trajroi::vlp16 {
 
-// One UDP datagram from the capture.
-struct CapturedDatagram {
-  std::span<const std::uint8_t> payload;  // valid until the next call to next()
-  std::uint16_t destination_port;
-  std::int64_t capture_time_ns;           // the pcap record's timestamp
+struct PcapOptions {
+  // UDP datagrams to these destination ports are delivered; others are skipped and counted.
+  std::vector<std::uint16_t> ports{kDataPort, kPositionPort};
+  // Replay pacing: 0 as fast as possible, 1 in real time, N at N × real time.
+  double speed = 0.0;
 };
 
 // Link types understood: Ethernet (with or without 802.1Q / 802.1ad tags), Linux cooked
-// capture SLL and SLL2, and raw IPv4. IPv4 fragments other than the first, non-UDP packets
-// and truncated records are skipped and counted.
-class PcapSource {
+// capture SLL and SLL2, and raw IPv4. IPv4 fragments other than the first, non-UDP packets,
+// other ports and records cut by the snap length are skipped and counted.
+class PcapSource final : public PacketSource {
  public:
   // Throws std::runtime_error naming the file when it cannot be opened or its link type is
-  // not one of the above.
-  explicit PcapSource(const std::filesystem::path& path);
-  ~PcapSource();
+  // not one of the above, or when the speed is negative.
+  explicit PcapSource(const std::filesystem::path& path, PcapOptions options = {});
+  ~PcapSource() override;
   PcapSource(const PcapSource&) = delete;
   PcapSource& operator=(const PcapSource&) = delete;
 
-  enum class Next { kDatagram, kEnd, kError };
-  // The next UDP datagram. kEnd at a clean end of file; kError when the file is cut inside
-  // a record (every complete record before the cut has been delivered) — error() says why.
-  Next next(CapturedDatagram& datagram);
+  Next next(Datagram& datagram, std::chrono::milliseconds timeout) override;
+  // As fast as the options allow, no timeout.
+  Next next(Datagram& datagram) { return next(datagram, std::chrono::milliseconds::max()); }
 
+  [[nodiscard]] const std::string& error() const noexcept override { return error_; }
   [[nodiscard]] std::uint64_t skipped_records() const noexcept { return skipped_; }
-  [[nodiscard]] const std::string& error() const noexcept { return error_; }
   [[nodiscard]] int link_type() const noexcept { return link_type_; }
 
  private:
+  Next read(Datagram& datagram);
+
   struct Handle;
   std::unique_ptr<Handle> handle_;
+  PcapOptions options_;
   int link_type_ = 0;
   std::uint64_t skipped_ = 0;
   std::string error_;
+  // Pacing: the first record's time and the steady-clock instant it was delivered.
+  bool paced_start_ = false;
+  std::int64_t first_record_ns_ = 0;
+  std::chrono::steady_clock::time_point first_delivery_;
+  bool pending_ = false;  // a datagram read but not yet due
+  Datagram pending_datagram_;
 };
 
 }  // namespace trajroi::vlp16

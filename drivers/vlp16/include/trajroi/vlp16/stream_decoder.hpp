@@ -1,0 +1,147 @@
+#pragma once
+
+// From a VLP-16's UDP packets to whole rotations ("frames"). Pure: the caller hands over
+// each payload with its receive time (from a socket or a pcap record) and gets frames back
+// through a FrameSink; nothing here reads a clock, a socket or a file.
+//
+// Time. Every frame is stamped in the receive clock: the first packet anchors the sensor's
+// top-of-hour timestamps to its receive time (less the packet's own duration, since it is
+// sent after its last firing), and later packets are spaced by their sensor timestamps, so
+// receive jitter does not reach the points. The anchor is reset (and counted) when the two
+// clocks part by more than kClockResetThreshold_ns. When position packets carry a valid RMC
+// with the PPS locked, frames also carry their start in UTC.
+//
+// Sequence. A timestamp step beyond 1.5 × the packet period (1327.1 µs single, 663.6 µs
+// dual), or, with a normal step, an azimuth advance beyond 1.5 × the expected one, counts
+// the packets in between as lost. A packet older than the previous one is counted out of
+// order and joins the current frame if it falls inside it; a repeated timestamp is a
+// duplicate and dropped.
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "trajroi/vlp16/decoder.hpp"
+#include "trajroi/vlp16/model_check.hpp"
+#include "trajroi/vlp16/packet.hpp"
+#include "trajroi/vlp16/position.hpp"
+
+namespace trajroi::vlp16 {
+
+inline constexpr std::int64_t kClockResetThreshold_ns = 100'000'000;
+// A frame is cut after this long even without an azimuth wrap (a stalled motor): ten times
+// the slowest sweep (5 Hz).
+inline constexpr std::int64_t kMaxFrameDuration_ns = 2'000'000'000;
+
+struct StreamOptions {
+  DecodeOptions decode;
+  double cut_azimuth_deg = 0.0;  // a frame begins at the first firing at or past this azimuth
+};
+
+struct Frame {
+  std::uint64_t index = 0;                  // 0, 1, … in the order frames complete
+  std::int64_t start_time_ns = 0;           // first point, receive clock
+  std::int64_t end_time_ns = 0;             // last point, receive clock
+  std::optional<std::int64_t> start_utc_ns; // first point in UTC, when the clock is locked
+  std::uint32_t packets = 0;                // packets whose first firing is in this frame
+  std::uint32_t lost_packets = 0;           // detected inside this frame
+  ReturnMode return_mode = ReturnMode::kStrongest;
+  // Not a whole sweep: the first frame (the stream started mid-sweep), the last one at
+  // flush(), and a frame cut by kMaxFrameDuration_ns.
+  bool partial = false;
+  std::vector<Point> points;                // time_offset_ns after start_time_ns
+};
+
+class FrameSink {
+ public:
+  virtual ~FrameSink() = default;
+  // The frame is valid during the call only; its storage is reused.
+  virtual void on_frame(const Frame& frame) = 0;
+};
+
+struct StreamCounters {
+  std::uint64_t data_packets = 0;      // handed to on_data_packet
+  std::uint64_t decoded_packets = 0;
+  std::array<std::uint64_t, kPacketErrorCount> rejected{};  // by PacketError (kNone unused)
+  std::uint64_t lost_packets = 0;
+  std::uint64_t out_of_order = 0;
+  std::uint64_t late_dropped = 0;      // out of order and older than the current frame
+  std::uint64_t duplicates = 0;
+  std::uint64_t clock_resets = 0;
+  std::uint64_t points = 0;
+  std::uint64_t no_return = 0;
+  std::uint64_t out_of_range = 0;
+  std::uint64_t merged_returns = 0;
+  std::uint64_t frames = 0;            // complete sweeps delivered
+  std::uint64_t partial_frames = 0;
+  std::uint64_t position_packets = 0;  // handed to on_position_packet
+  std::uint64_t position_wrong_size = 0;
+  std::array<std::uint64_t, kNmeaErrorCount> nmea{};  // by NmeaError (kNone: good RMCs)
+
+  [[nodiscard]] std::uint64_t rejected_total() const noexcept;
+};
+
+class StreamDecoder {
+ public:
+  StreamDecoder(const Calibration& calibration, StreamOptions options);
+
+  // One port-2368 payload. May complete a frame (rarely two) into `sink`.
+  void on_data_packet(std::span<const std::uint8_t> payload, std::int64_t receive_time_ns, FrameSink& sink);
+  // One port-8308 payload.
+  void on_position_packet(std::span<const std::uint8_t> payload);
+  // Delivers the frame in progress (partial), e.g. at the end of a capture.
+  void flush(FrameSink& sink);
+
+  [[nodiscard]] const StreamCounters& counters() const noexcept { return counters_; }
+  // The product id and return mode of the last decoded packet.
+  [[nodiscard]] std::optional<std::uint8_t> product_id() const noexcept { return product_id_; }
+  [[nodiscard]] std::optional<ReturnMode> return_mode() const noexcept { return return_mode_; }
+  // Why the last packet rejected for its model was rejected; empty if none was.
+  [[nodiscard]] const std::string& model_rejection() const noexcept { return model_.reason(); }
+  [[nodiscard]] const std::optional<PositionPacket>& first_rmc() const noexcept { return first_rmc_; }
+  [[nodiscard]] const std::optional<PositionPacket>& last_rmc() const noexcept { return last_rmc_; }
+  [[nodiscard]] const TopOfHourClock& utc_clock() const noexcept { return utc_clock_; }
+
+ private:
+  void accept(std::span<const std::uint8_t> packet, std::int64_t receive_time_ns, FrameSink& sink);
+  void append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns);
+  std::int64_t packet_time_ns(std::uint32_t toh_us, std::int64_t receive_time_ns, double period_us);
+  void finish_frame(FrameSink& sink, bool partial);
+
+  PacketDecoder decoder_;
+  StreamOptions options_;
+  ModelCheck model_;
+  TopOfHourClock utc_clock_;
+  StreamCounters counters_;
+
+  // 0x21 packets waiting for the model check's verdict (at most ModelCheck::kMaxUndecided).
+  struct HeldPacket {
+    std::array<std::uint8_t, kDataPacketBytes> bytes;
+    std::int64_t receive_time_ns;
+  };
+  std::vector<HeldPacket> held_;
+
+  // Sequence and clock state of the last accepted packet.
+  bool have_last_ = false;
+  std::uint32_t last_toh_us_ = 0;
+  std::uint16_t last_first_azimuth_ = 0;
+  double rate_cdeg_per_us_ = 0.0;  // measured inside the last packet
+  std::int64_t anchor_time_ns_ = 0;
+  std::int64_t unwrapped_toh_us_ = 0;  // last packet's timestamp, unwrapped from the anchor
+  double last_phase_deg_ = 0.0;        // of the last point placed, from the cut azimuth
+  bool have_phase_ = false;
+
+  Frame frame_;
+  bool first_frame_ = true;
+  std::uint64_t next_index_ = 0;
+  std::vector<Point> scratch_;
+
+  std::optional<std::uint8_t> product_id_;
+  std::optional<ReturnMode> return_mode_;
+  std::optional<PositionPacket> first_rmc_;
+  std::optional<PositionPacket> last_rmc_;
+};
+
+}  // namespace trajroi::vlp16

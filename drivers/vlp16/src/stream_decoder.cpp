@@ -1,0 +1,243 @@
+#include "trajroi/vlp16/stream_decoder.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+namespace trajroi::vlp16 {
+namespace {
+
+constexpr double kBlockDuration_us = 2.0 * kFiringCycle_us;
+constexpr double kLossFactor = 1.5;  // a step beyond 1.5 expected ones means packets are missing
+// Points reserved for a frame: a dual-return sweep at 5 Hz is about 300 packets of up to 384.
+constexpr std::size_t kFrameReserve = 300 * kBlocks * kFiringsPerBlock * kLasers;
+
+std::uint32_t azimuth_gap(std::uint16_t from, std::uint16_t to) noexcept {
+  return (static_cast<std::uint32_t>(to) + kAzimuthLimit - from) % kAzimuthLimit;
+}
+
+// Packets missing in a step of `observed` where `expected` was due, at least one.
+std::uint32_t missing(double observed, double expected) noexcept {
+  const double n = std::round(observed / expected) - 1.0;
+  return n < 1.0 ? 1u : n > 1e9 ? 1'000'000'000u : static_cast<std::uint32_t>(n);
+}
+
+}  // namespace
+
+std::uint64_t StreamCounters::rejected_total() const noexcept {
+  std::uint64_t total = 0;
+  for (const std::uint64_t n : rejected) total += n;
+  return total;
+}
+
+StreamDecoder::StreamDecoder(const Calibration& calibration, StreamOptions options)
+    : decoder_(calibration, options.decode), options_(options) {
+  options_.cut_azimuth_deg = std::fmod(options_.cut_azimuth_deg, 360.0);
+  if (options_.cut_azimuth_deg < 0.0) options_.cut_azimuth_deg += 360.0;
+  held_.reserve(ModelCheck::kMaxUndecided);
+  frame_.points.reserve(kFrameReserve);
+  scratch_.reserve(kBlocks * kFiringsPerBlock * kLasers);
+}
+
+void StreamDecoder::on_data_packet(std::span<const std::uint8_t> payload, std::int64_t receive_time_ns,
+                                   FrameSink& sink) {
+  ++counters_.data_packets;
+  const PacketError error = validate_data_packet(payload);
+  if (error != PacketError::kNone) {
+    ++counters_.rejected[static_cast<std::size_t>(error)];
+    if (error == PacketError::kUnsupportedProduct) (void)model_.check(payload);  // records the reason
+    return;
+  }
+  switch (model_.check(payload)) {
+    case ModelCheck::Verdict::kVlp16:
+      for (const HeldPacket& held : held_) accept(held.bytes, held.receive_time_ns, sink);
+      held_.clear();
+      accept(payload, receive_time_ns, sink);
+      return;
+    case ModelCheck::Verdict::kUndecided:
+      if (held_.size() < ModelCheck::kMaxUndecided) {
+        HeldPacket& held = held_.emplace_back();
+        std::copy(payload.begin(), payload.end(), held.bytes.begin());
+        held.receive_time_ns = receive_time_ns;
+        return;
+      }
+      break;  // cannot happen: the check decides within kMaxUndecided packets
+    case ModelCheck::Verdict::kRejected:
+      break;
+  }
+  counters_.rejected[static_cast<std::size_t>(PacketError::kUnsupportedProduct)] += 1 + held_.size();
+  held_.clear();
+}
+
+void StreamDecoder::on_position_packet(std::span<const std::uint8_t> payload) {
+  ++counters_.position_packets;
+  PositionPacket packet;
+  if (!parse_position_packet(payload, packet)) {
+    ++counters_.position_wrong_size;
+    return;
+  }
+  ++counters_.nmea[static_cast<std::size_t>(packet.nmea)];
+  if (packet.nmea == NmeaError::kNone) {
+    if (!first_rmc_) first_rmc_ = packet;
+    last_rmc_ = packet;
+  }
+  utc_clock_.on_position(packet);
+}
+
+std::int64_t StreamDecoder::packet_time_ns(std::uint32_t toh_us, std::int64_t receive_time_ns, double period_us) {
+  // The packet leaves the sensor after its last firing: its first one was a period earlier.
+  const std::int64_t by_receive = receive_time_ns - std::llround(period_us * 1000.0);
+  if (!have_last_) {
+    anchor_time_ns_ = by_receive;
+    unwrapped_toh_us_ = 0;
+    return by_receive;
+  }
+  unwrapped_toh_us_ += toh_delta_us(last_toh_us_, toh_us);
+  const std::int64_t by_sensor = anchor_time_ns_ + unwrapped_toh_us_ * 1000;
+  if (std::llabs(by_sensor - by_receive) <= kClockResetThreshold_ns) return by_sensor;
+  ++counters_.clock_resets;
+  anchor_time_ns_ = by_receive;
+  unwrapped_toh_us_ = 0;
+  return by_receive;
+}
+
+void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t receive_time_ns, FrameSink& sink) {
+  const auto mode = static_cast<ReturnMode>(return_mode_byte(packet));
+  const bool dual = mode == ReturnMode::kDual;
+  const std::size_t step = dual ? 2 : 1;
+  const double period_us = static_cast<double>(kBlocks / step) * kBlockDuration_us;
+  const std::uint32_t toh = timestamp_us(packet);
+  const std::uint16_t first_azimuth = block_azimuth(packet, 0);
+
+  std::uint32_t lost = 0;
+  std::int64_t delta_us = 0;
+  if (have_last_) {
+    delta_us = toh_delta_us(last_toh_us_, toh);
+    if (delta_us == 0) {
+      ++counters_.duplicates;
+      return;
+    }
+    if (delta_us < 0) {
+      ++counters_.out_of_order;
+      // It was counted lost when the packet after it came first.
+      if (frame_.lost_packets > 0) {
+        --frame_.lost_packets;
+        --counters_.lost_packets;
+      }
+      append_late(packet, anchor_time_ns_ + (unwrapped_toh_us_ + delta_us) * 1000);
+      return;
+    }
+    const auto delta = static_cast<double>(delta_us);
+    if (delta > kLossFactor * period_us) {
+      lost = missing(delta, period_us);
+    } else if (rate_cdeg_per_us_ > 0.0) {
+      const double expected_cdeg = rate_cdeg_per_us_ * delta;
+      const auto observed_cdeg = static_cast<double>(azimuth_gap(last_first_azimuth_, first_azimuth));
+      if (observed_cdeg > kLossFactor * expected_cdeg) lost = missing(observed_cdeg, expected_cdeg);
+    }
+  }
+  const std::int64_t time_ns = packet_time_ns(toh, receive_time_ns, period_us);
+  const std::optional<std::int64_t> utc_ns = utc_clock_.to_utc_ns(toh);
+
+  if (lost > 0) {
+    counters_.lost_packets += lost;
+    frame_.lost_packets += lost;
+    // Packets lost across the cut azimuth take the cut with them: close the frame here.
+    const double advance_deg = rate_cdeg_per_us_ * static_cast<double>(delta_us) / 100.0;
+    if (have_phase_ && last_phase_deg_ + advance_deg >= 360.0) {
+      finish_frame(sink, false);
+      have_phase_ = false;
+    }
+  }
+  have_last_ = true;
+  last_toh_us_ = toh;
+  last_first_azimuth_ = first_azimuth;
+  const std::size_t last_firing_block = kBlocks - step;
+  const std::uint32_t span_cdeg = azimuth_gap(first_azimuth, block_azimuth(packet, last_firing_block));
+  rate_cdeg_per_us_ = static_cast<double>(span_cdeg) / (static_cast<double>(kBlocks / step - 1) * kBlockDuration_us);
+
+  scratch_.clear();
+  const PacketDecoder::Result r = decoder_.decode(packet, scratch_);
+  ++counters_.decoded_packets;
+  counters_.points += r.points;
+  counters_.no_return += r.no_return;
+  counters_.out_of_range += r.out_of_range;
+  counters_.merged_returns += r.merged_returns;
+  product_id_ = vlp16::product_id(packet);
+  return_mode_ = mode;
+
+  bool counted = false;
+  for (const Point& point : scratch_) {
+    double phase = static_cast<double>(point.azimuth_deg) - options_.cut_azimuth_deg;
+    if (phase < 0.0) phase += 360.0;
+    const std::int64_t t = time_ns + point.time_offset_ns;
+    if (have_phase_ && phase < last_phase_deg_ - 180.0) {
+      finish_frame(sink, false);
+    } else if (!frame_.points.empty() && t - frame_.start_time_ns > kMaxFrameDuration_ns) {
+      finish_frame(sink, true);
+    }
+    last_phase_deg_ = phase;
+    have_phase_ = true;
+    if (frame_.points.empty()) {
+      frame_.start_time_ns = t;
+      frame_.end_time_ns = t;
+      frame_.start_utc_ns = utc_ns ? std::optional(*utc_ns + point.time_offset_ns) : std::nullopt;
+      frame_.return_mode = mode;
+    }
+    if (!counted) {
+      ++frame_.packets;
+      counted = true;
+    }
+    Point& placed = frame_.points.emplace_back(point);
+    placed.time_offset_ns = static_cast<std::uint32_t>(t - frame_.start_time_ns);
+    frame_.end_time_ns = std::max(frame_.end_time_ns, t);
+  }
+  if (!counted) ++frame_.packets;
+}
+
+void StreamDecoder::append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns) {
+  if (frame_.points.empty() || packet_time_ns < frame_.start_time_ns) {
+    ++counters_.late_dropped;
+    return;
+  }
+  scratch_.clear();
+  const PacketDecoder::Result r = decoder_.decode(packet, scratch_);
+  ++counters_.decoded_packets;
+  counters_.points += r.points;
+  counters_.no_return += r.no_return;
+  counters_.out_of_range += r.out_of_range;
+  counters_.merged_returns += r.merged_returns;
+  ++frame_.packets;
+  for (const Point& point : scratch_) {
+    const std::int64_t t = packet_time_ns + point.time_offset_ns;
+    Point& placed = frame_.points.emplace_back(point);
+    placed.time_offset_ns = static_cast<std::uint32_t>(t - frame_.start_time_ns);
+    frame_.end_time_ns = std::max(frame_.end_time_ns, t);
+  }
+}
+
+void StreamDecoder::finish_frame(FrameSink& sink, bool partial) {
+  if (!frame_.points.empty() || frame_.packets > 0) {
+    frame_.index = next_index_++;
+    frame_.partial = partial || first_frame_;
+    ++(frame_.partial ? counters_.partial_frames : counters_.frames);
+    sink.on_frame(frame_);
+    first_frame_ = false;
+  }
+  frame_.points.clear();
+  frame_.packets = 0;
+  frame_.lost_packets = 0;
+  frame_.start_time_ns = 0;
+  frame_.end_time_ns = 0;
+  frame_.start_utc_ns.reset();
+}
+
+void StreamDecoder::flush(FrameSink& sink) {
+  // 0x21 packets still waiting for a verdict never showed a VLP-16's timing.
+  counters_.rejected[static_cast<std::size_t>(PacketError::kUnsupportedProduct)] += held_.size();
+  held_.clear();
+  finish_frame(sink, true);
+  have_phase_ = false;
+}
+
+}  // namespace trajroi::vlp16
