@@ -1,0 +1,276 @@
+// The stream decoder on synthetic packet streams: a simulated VLP-16 spinning at 10 Hz,
+// with packets dropped, swapped, repeated, damaged or mislabelled on purpose.
+#include "trajroi/vlp16/stream_decoder.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+#include "packet_builder.hpp"
+
+namespace trajroi::vlp16 {
+namespace {
+
+// A VLP-16 at 10 Hz: 0.40° per firing, a packet every 1327.104 µs (single) or 663.552 µs
+// (dual), every channel returning 2 m.
+struct Sensor {
+  ReturnMode mode = ReturnMode::kStrongest;
+  std::uint8_t product = kProductVlp16;
+  double toh_us = 1'000'000.0;
+  std::uint32_t azimuth_cdeg = 0;
+  std::int64_t receive_ns = 1'700'000'000'000'000'000;
+  double period_us = 12 * 110.592;  // single; dual halves it
+  std::uint16_t step_cdeg = 40;
+
+  std::vector<std::uint8_t> next() {
+    const bool dual = mode == ReturnMode::kDual;
+    const double period = dual ? period_us / 2.0 : period_us;
+    auto p = make_packet(static_cast<std::uint16_t>(azimuth_cdeg), step_cdeg, mode, product,
+                         static_cast<std::uint32_t>(std::llround(toh_us)) % 3'600'000'000u);
+    for (std::size_t block = 0; block < kBlocks; ++block) {
+      for (std::size_t channel = 0; channel < 32; ++channel) set_return(p, block, channel, 1000, 10);
+    }
+    const std::size_t firings = dual ? kBlocks / 2 : kBlocks;
+    azimuth_cdeg = (azimuth_cdeg + step_cdeg * static_cast<std::uint32_t>(firings)) % 36000;
+    toh_us += period;
+    receive_ns += std::llround(period * 1000.0);
+    return p;
+  }
+  [[nodiscard]] std::int64_t received() const { return receive_ns; }
+};
+
+struct Collector final : FrameSink {
+  std::vector<Frame> frames;
+  void on_frame(const Frame& frame) override { frames.push_back(frame); }
+};
+
+// Feeds `count` packets of `sensor`, letting `edit` drop (return false) or change each.
+struct Outcome {
+  Collector sink;
+  StreamCounters counters;
+  std::string rejection;
+};
+Outcome run(Sensor sensor, std::size_t count, StreamOptions options = {},
+        const std::function<bool(std::size_t, std::vector<std::uint8_t>&)>& edit = {}) {
+  Outcome r;
+  StreamDecoder decoder(Calibration::vlp16_default(), options);
+  for (std::size_t i = 0; i < count; ++i) {
+    auto p = sensor.next();
+    if (edit && !edit(i, p)) continue;
+    decoder.on_data_packet(p, sensor.received(), r.sink);
+  }
+  decoder.flush(r.sink);
+  r.counters = decoder.counters();
+  r.rejection = decoder.model_rejection();
+  return r;
+}
+
+constexpr std::size_t kPacketsPerTurn = 75;  // 36000 / (12 × 40)
+
+TEST(Vlp16Stream, CleanStreamGivesWholeSweepsCutAtTheConfiguredAzimuth) {
+  for (const double cut_deg : {0.0, 90.0, 359.5}) {
+    StreamOptions options;
+    options.cut_azimuth_deg = cut_deg;
+    const Outcome r = run(Sensor{}, 4 * kPacketsPerTurn + 10, options);
+    EXPECT_EQ(r.counters.decoded_packets, 4 * kPacketsPerTurn + 10);
+    EXPECT_EQ(r.counters.lost_packets, 0u);
+    EXPECT_EQ(r.counters.clock_resets, 0u);
+    ASSERT_GE(r.sink.frames.size(), 4u) << cut_deg;
+    EXPECT_TRUE(r.sink.frames.front().partial);
+    EXPECT_TRUE(r.sink.frames.back().partial);
+    std::size_t points = 0;
+    for (const Frame& f : r.sink.frames) points += f.points.size();
+    EXPECT_EQ(points, r.counters.points);
+    for (std::size_t i = 1; i + 1 < r.sink.frames.size(); ++i) {
+      const Frame& f = r.sink.frames[i];
+      EXPECT_FALSE(f.partial);
+      EXPECT_EQ(f.points.size(), kPacketsPerTurn * 384);  // exactly one turn of firings
+      // Starts at the first firing at or past the cut, ends at the last before it.
+      const auto phase = [&](const Point& p) { return std::fmod(double{p.azimuth_deg} - cut_deg + 360.0, 360.0); };
+      EXPECT_LT(phase(f.points.front()), 0.4) << cut_deg;
+      EXPECT_GT(phase(f.points.back()), 359.5) << cut_deg;
+      // One turn is 75 packets of 1327.104 µs; from a frame's first point to its last is that
+      // less the gap between two successive points: 20.736 µs when the cut falls between
+      // firings (laser 15 of sequence 2 to laser 0 of the next), 2.304 µs inside one.
+      // Timestamps are whole µs.
+      const auto span_ns = static_cast<double>(f.end_time_ns - f.start_time_ns);
+      EXPECT_GE(span_ns, (75 * 1327.104 - 20.736) * 1e3 - 1e3) << cut_deg;
+      EXPECT_LE(span_ns, (75 * 1327.104 - 2.304) * 1e3 + 1e3) << cut_deg;
+      EXPECT_EQ(f.points.front().time_offset_ns, 0u);
+      EXPECT_EQ(static_cast<std::int64_t>(f.points.back().time_offset_ns), f.end_time_ns - f.start_time_ns);
+      EXPECT_FALSE(f.start_utc_ns.has_value());
+      EXPECT_EQ(f.index, i);
+    }
+    EXPECT_EQ(r.counters.frames + r.counters.partial_frames, r.sink.frames.size());
+  }
+}
+
+TEST(Vlp16Stream, MissingPacketsAreCountedInTheirFrame) {
+  const Outcome r = run(Sensor{}, 3 * kPacketsPerTurn, {}, [](std::size_t i, auto&) { return i < 100 || i > 102; });
+  EXPECT_EQ(r.counters.lost_packets, 3u);
+  std::uint32_t in_frames = 0;
+  for (const Frame& f : r.sink.frames) in_frames += f.lost_packets;
+  EXPECT_EQ(in_frames, 3u);
+  EXPECT_EQ(r.sink.frames[1].lost_packets, 3u);  // packets 75 … 149
+}
+
+TEST(Vlp16Stream, LossAcrossTheCutStillCutsTheSweep) {
+  // Packets 70 … 80 span the 0° crossing at packet 75: no point shows the wrap.
+  const Outcome r = run(Sensor{}, 3 * kPacketsPerTurn, {}, [](std::size_t i, auto&) { return i < 70 || i > 80; });
+  EXPECT_EQ(r.counters.lost_packets, 11u);
+  ASSERT_EQ(r.sink.frames.size(), 3u);
+  EXPECT_EQ(r.sink.frames[0].lost_packets, 5u);  // 70 … 74 before the cut
+  EXPECT_EQ(r.sink.frames[1].lost_packets, 6u);  // 75 … 80 after it
+  EXPECT_FALSE(r.sink.frames[1].partial);
+  EXPECT_EQ(r.sink.frames[1].points.size(), (kPacketsPerTurn - 6) * 384);
+  EXPECT_EQ(r.sink.frames[1].packets, kPacketsPerTurn - 6);
+}
+
+TEST(Vlp16Stream, AzimuthJumpWithoutATimestampGapCountsLoss) {
+  // A sensor whose clock stands still between packets 40 and 41 (timestamps repeat their
+  // spacing) but whose rotation skipped two packets' worth of azimuth.
+  Sensor sensor;
+  StreamDecoder decoder(Calibration::vlp16_default(), {});
+  Collector sink;
+  for (std::size_t i = 0; i < 60; ++i) {
+    auto p = sensor.next();
+    if (i == 40) sensor.azimuth_cdeg = (sensor.azimuth_cdeg + 2 * 480) % 36000;
+    decoder.on_data_packet(p, sensor.received(), sink);
+  }
+  EXPECT_EQ(decoder.counters().lost_packets, 2u);
+}
+
+TEST(Vlp16Stream, SwappedPacketsAreOutOfOrderNotLost) {
+  std::vector<std::uint8_t> held;
+  Sensor sensor;
+  StreamDecoder decoder(Calibration::vlp16_default(), {});
+  Collector sink;
+  for (std::size_t i = 0; i < 2 * kPacketsPerTurn; ++i) {
+    auto p = sensor.next();
+    if (i == 90) {
+      held = p;  // delivered after packet 91
+      continue;
+    }
+    decoder.on_data_packet(p, sensor.received(), sink);
+    if (i == 91) decoder.on_data_packet(held, sensor.received(), sink);
+  }
+  decoder.flush(sink);
+  EXPECT_EQ(decoder.counters().out_of_order, 1u);
+  EXPECT_EQ(decoder.counters().lost_packets, 0u);
+  EXPECT_EQ(decoder.counters().late_dropped, 0u);
+  EXPECT_EQ(decoder.counters().points, 2 * kPacketsPerTurn * 384);
+  EXPECT_EQ(sink.frames[1].points.size(), kPacketsPerTurn * 384);  // nothing lost from the sweep
+  EXPECT_EQ(sink.frames[1].lost_packets, 0u);
+}
+
+TEST(Vlp16Stream, RepeatedPacketIsADuplicate) {
+  Sensor sensor;
+  StreamDecoder decoder(Calibration::vlp16_default(), {});
+  Collector sink;
+  for (std::size_t i = 0; i < 20; ++i) {
+    auto p = sensor.next();
+    decoder.on_data_packet(p, sensor.received(), sink);
+    if (i == 5) decoder.on_data_packet(p, sensor.received(), sink);
+  }
+  EXPECT_EQ(decoder.counters().duplicates, 1u);
+  EXPECT_EQ(decoder.counters().decoded_packets, 20u);
+}
+
+TEST(Vlp16Stream, TopOfHourWrapIsNotALossNorAClockReset) {
+  Sensor sensor;
+  sensor.toh_us = 3'600'000'000.0 - 30 * 1327.104;  // wraps after 30 packets
+  const Outcome r = run(sensor, 2 * kPacketsPerTurn);
+  EXPECT_EQ(r.counters.lost_packets, 0u);
+  EXPECT_EQ(r.counters.out_of_order, 0u);
+  EXPECT_EQ(r.counters.clock_resets, 0u);
+  EXPECT_EQ(r.counters.decoded_packets, 2 * kPacketsPerTurn);
+}
+
+TEST(Vlp16Stream, DualReturnStreamHasHalfThePeriod) {
+  Sensor sensor;
+  sensor.mode = ReturnMode::kDual;
+  const Outcome r = run(sensor, 4 * kPacketsPerTurn);
+  EXPECT_EQ(r.counters.lost_packets, 0u);
+  for (std::size_t i = 1; i + 1 < r.sink.frames.size(); ++i) {
+    EXPECT_EQ(r.sink.frames[i].return_mode, ReturnMode::kDual);
+    EXPECT_EQ(r.sink.frames[i].packets, 2 * kPacketsPerTurn);
+    // Both returns 2 m: one kBoth point per firing channel.
+    EXPECT_EQ(r.sink.frames[i].points.size(), kPacketsPerTurn * 384);
+  }
+}
+
+TEST(Vlp16Stream, ProductId0x21WithVlp16TimingIsAcceptedAndItsFirstPacketKept) {
+  Sensor sensor;
+  sensor.product = kProductHdl32e;
+  const Outcome r = run(sensor, 10);
+  EXPECT_EQ(r.counters.rejected_total(), 0u) << r.rejection;
+  EXPECT_EQ(r.counters.decoded_packets, 10u);
+  EXPECT_EQ(r.counters.points, 10u * 384u);
+}
+
+TEST(Vlp16Stream, ProductId0x21WithHdl32eTimingIsRejectedWithTheReason) {
+  Sensor sensor;
+  sensor.product = kProductHdl32e;
+  sensor.period_us = 12 * 46.08;  // 552.96 µs
+  sensor.step_cdeg = 17;          // 0.17° per firing at 10 Hz
+  const Outcome r = run(sensor, 10);
+  EXPECT_EQ(r.counters.rejected[static_cast<std::size_t>(PacketError::kUnsupportedProduct)], 10u);
+  EXPECT_EQ(r.counters.decoded_packets, 0u);
+  EXPECT_NE(r.rejection.find("HDL-32E"), std::string::npos);
+  EXPECT_NE(r.rejection.find("553 µs"), std::string::npos) << r.rejection;
+}
+
+TEST(Vlp16Stream, ProductId0x21RightPeriodWrongRotationIsRejected) {
+  Sensor sensor;
+  sensor.product = kProductHdl32e;
+  sensor.step_cdeg = 5;  // 0.05° per firing: 1.25 Hz, no VLP-16 spins that slowly
+  const Outcome r = run(sensor, 5);
+  EXPECT_EQ(r.counters.decoded_packets, 0u);
+  EXPECT_EQ(r.counters.rejected_total(), 5u);
+}
+
+TEST(Vlp16Stream, DamagedPacketsAreCountedByReasonAndTheRestDecoded) {
+  const Outcome r = run(Sensor{}, 40, {}, [](std::size_t i, std::vector<std::uint8_t>& p) {
+    if (i == 3) p.resize(1000);
+    if (i == 4) p[500] = 0x00;  // block 5 flag
+    if (i == 5) p[1204] = 0x3A;
+    if (i == 6) p[1205] = 0x28;
+    if (i == 7) {
+      p[202] = 0xFF;  // block 2 azimuth 0xFFFF
+      p[203] = 0xFF;
+    }
+    return true;
+  });
+  using E = PacketError;
+  for (const E e : {E::kWrongSize, E::kBadBlockFlag, E::kUnknownReturnMode, E::kUnsupportedProduct, E::kAzimuthOutOfRange}) {
+    EXPECT_EQ(r.counters.rejected[static_cast<std::size_t>(e)], 1u) << to_string(e);
+  }
+  EXPECT_EQ(r.counters.decoded_packets, 35u);
+  EXPECT_EQ(r.counters.lost_packets, 5u);  // the stream has a 5-packet hole
+  EXPECT_NE(r.rejection.find("0x28 (VLP-32C)"), std::string::npos);
+}
+
+TEST(Vlp16Stream, LockedPositionPacketsGiveFramesTheirUtcStart) {
+  Sensor sensor;
+  sensor.toh_us = 1'082'000'000.0;  // 08:18:02.000 on the sensor's hour clock
+  StreamDecoder decoder(Calibration::vlp16_default(), {});
+  const auto position = make_position_packet(
+      1'082'000'500, 2, "$GPRMC,081802.00,A,3649.7478558,N,00224.4542928,W,0.034,212.5,210116,0.0,E,A*2E\r\n");
+  decoder.on_position_packet(position);
+  ASSERT_TRUE(decoder.utc_clock().locked());
+  Collector sink;
+  for (std::size_t i = 0; i <= 2 * kPacketsPerTurn; ++i) {
+    const auto p = sensor.next();
+    decoder.on_data_packet(p, sensor.received(), sink);
+  }
+  ASSERT_GE(sink.frames.size(), 2u);
+  const Frame& f = sink.frames[1];
+  ASSERT_TRUE(f.start_utc_ns.has_value());
+  // 2016-01-21 08:00:00 UTC = 1453363200 s; the sweep starts at packet 75, 0.0995 s in.
+  const double expected_s = 1453363200.0 + 1082.0 + 75 * 1327.104e-6;
+  EXPECT_NEAR(static_cast<double>(*f.start_utc_ns) * 1e-9, expected_s, 2e-6);
+}
+
+}  // namespace
+}  // namespace trajroi::vlp16

@@ -141,12 +141,21 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
 
   if (lost > 0) {
     counters_.lost_packets += lost;
-    frame_.lost_packets += lost;
-    // Packets lost across the cut azimuth take the cut with them: close the frame here.
-    const double advance_deg = rate_cdeg_per_us_ * static_cast<double>(delta_us) / 100.0;
-    if (have_phase_ && last_phase_deg_ + advance_deg >= 360.0) {
+    // Packets lost across the cut azimuth take the cut with them: close the frame here,
+    // giving it the lost packets whose first firing was still before the cut.
+    const double per_packet_deg = rate_cdeg_per_us_ * period_us / 100.0;
+    double last_start_phase = static_cast<double>(last_first_azimuth_) / 100.0 - options_.cut_azimuth_deg;
+    if (last_start_phase < 0.0) last_start_phase += 360.0;
+    const double lost_span_deg = per_packet_deg * static_cast<double>(lost);
+    if (have_phase_ && per_packet_deg > 0.0 && last_start_phase + lost_span_deg + per_packet_deg >= 360.0) {
+      const double before = std::ceil((360.0 - last_start_phase) / per_packet_deg - 1e-6) - 1.0;
+      const auto lost_before = static_cast<std::uint32_t>(std::clamp(before, 0.0, static_cast<double>(lost)));
+      frame_.lost_packets += lost_before;
       finish_frame(sink, false);
       have_phase_ = false;
+      frame_.lost_packets += lost - lost_before;
+    } else {
+      frame_.lost_packets += lost;
     }
   }
   have_last_ = true;

@@ -30,7 +30,7 @@ std::int64_t realtime_now_ns() noexcept {
 UdpSource::UdpSource(UdpOptions options) : options_(std::move(options)) {
   if (options_.batch == 0) options_.batch = 1;
   open_socket(sockets_[0], options_.data_port, true);
-  if (options_.position_port != 0) open_socket(sockets_[1], options_.position_port, false);
+  if (options_.open_position_socket) open_socket(sockets_[1], options_.position_port, false);
 }
 
 UdpSource::~UdpSource() {

@@ -37,7 +37,9 @@ inline constexpr std::int64_t kMaxFrameDuration_ns = 2'000'000'000;
 
 struct StreamOptions {
   DecodeOptions decode;
-  double cut_azimuth_deg = 0.0;  // a frame begins at the first firing at or past this azimuth
+  // A frame begins with the first point whose (interpolated) firing azimuth is at or past
+  // this azimuth; a firing that straddles it is split between the two frames.
+  double cut_azimuth_deg = 0.0;
 };
 
 struct Frame {

@@ -17,8 +17,9 @@ namespace trajroi::vlp16 {
 
 struct UdpOptions {
   std::string bind_address = "0.0.0.0";  // IPv4 address to bind both sockets to
-  std::uint16_t data_port = kDataPort;
-  std::uint16_t position_port = kPositionPort;  // 0: do not open a position socket
+  std::uint16_t data_port = kDataPort;  // 0: the kernel chooses (tests)
+  std::uint16_t position_port = kPositionPort;
+  bool open_position_socket = true;
   int receive_buffer_bytes = 4 << 20;  // SO_RCVBUF asked for; see granted_receive_buffer_bytes()
   std::size_t batch = 32;              // datagrams per recvmmsg
 };
