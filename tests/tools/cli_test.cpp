@@ -9,6 +9,8 @@
 #include <sstream>
 #include <string>
 
+#include "test_data.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -149,6 +151,60 @@ TEST_F(Cli, EvalArtificialWritesSvgPictures) {
   EXPECT_NE(svg.find("272 ROIs — TP 11803, FP 49"), std::string::npos);
   EXPECT_NE(svg.find("<polygon"), std::string::npos);
   EXPECT_NE(svg.find("</svg>"), std::string::npos);
+}
+
+// lidar-dump on the real captures: the figures the data README gives (from its own walker)
+// and the GPRMC sentence of the MRPT capture.
+TEST_F(Cli, LidarDumpReportsTheMrptCapture) {
+  TRAJROI_REQUIRE_DATA(capture, "velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap");
+  const fs::path points = dir_ / "points.csv";
+  const CommandResult r = run("lidar-dump --json " + capture.string() + " --points " + points.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* field :
+       {"\"data_packets\": 293,", "\"position_packets\": 57,", "\"unsupported_product\": 0}", "\"model\": \"VLP-16\"",
+        "\"product_id\": \"0x22\"", "\"return_mode\": \"strongest\"", "\"frames\": 3,", "\"partial_frames\": 2,",
+        "\"points\": 73486,", "\"lost_packets\": 0,",
+        "\"first\": {\"utc\": \"2016-01-21T08:18:02.000Z\", \"valid\": true, \"lat\": 36.829130930, \"lon\": -2.407571547}"}) {
+    EXPECT_NE(r.out.find(field), std::string::npos) << field << " not in " << r.out;
+  }
+  const std::string csv = slurp(points);
+  EXPECT_EQ(csv.rfind("frame,x,y,z,intensity,ring,azimuth_deg,distance_m,time_ns,return_type\n", 0), 0u);
+  std::size_t rows = 0;
+  for (const char c : csv) rows += c == '\n' ? 1 : 0;
+  EXPECT_EQ(rows, 73486u + 1u);
+  EXPECT_FALSE(fs::exists(dir_ / "points.csv.partial"));
+}
+
+TEST_F(Cli, LidarDumpNamesTheRejectedModel) {
+  TRAJROI_REQUIRE_DATA(capture, "velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap");
+  const CommandResult r = run("lidar-dump --json " + capture.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"unsupported_product\": 500}"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"model\": \"HDL-32E\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("product id 0x21 (HDL-32E) is not supported"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"points\": 0,"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, LidarDumpOfATruncatedCaptureReportsWhatItReadThenFails) {
+  TRAJROI_REQUIRE_DATA(capture, "velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap");
+  const std::string bytes = trajroi::test::read_file(capture);
+  const fs::path cut = write("cut.pcap", "");
+  std::ofstream(cut, std::ios::binary).write(bytes.data(), 200'000);
+  const CommandResult r = run("lidar-dump --json " + cut.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.out.find("\"read_error\": \""), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("truncated"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, LidarDumpRejectsAMissingFileAndABadCalibration) {
+  CommandResult r = run("lidar-dump /nonexistent.pcap");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("/nonexistent.pcap"), std::string::npos) << r.err;
+  const fs::path yaml = write("bad.yaml", "lasers:\n  - {laser_id: 0, vert_correction: 0.1}\n");
+  const fs::path pcap = write("empty.pcap", "");
+  r = run("lidar-dump " + pcap.string() + " --calibration " + yaml.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("bad.yaml: 'lasers' has 1 entries; a VLP-16 has 16"), std::string::npos) << r.err;
 }
 
 }  // namespace

@@ -7,5 +7,6 @@ namespace trajroi::cli {
 // Each adds one subcommand (with its options and its callback) to the application.
 void add_eval_commands(CLI::App& app);
 void add_filter_command(CLI::App& app);
+void add_lidar_dump_command(CLI::App& app);
 
 }  // namespace trajroi::cli

@@ -9,6 +9,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   trajroi::cli::add_eval_commands(app);
   trajroi::cli::add_filter_command(app);
+  trajroi::cli::add_lidar_dump_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
