@@ -3,6 +3,7 @@
 #include "trajroi/vlp16/decoder.hpp"
 
 #include "packet_builder.hpp"
+#include "test_data.hpp"
 
 #include <gtest/gtest.h>
 
@@ -142,6 +143,130 @@ TEST(Vlp16Decoder, DualReturnPairsShareTheFiringAndIdenticalReturnsGiveOnePoint)
   EXPECT_EQ(points[3].return_type, ReturnType::kStrongest);
   EXPECT_EQ(points[3].intensity, 50);
   EXPECT_EQ(points[3].time_offset_ns, static_cast<std::uint32_t>(std::lround((2 * 110.592 + 6 * 2.304) * 1000)));
+}
+
+}  // namespace
+}  // namespace trajroi::vlp16
+
+namespace trajroi::vlp16 {
+namespace {
+
+constexpr const char* kTwoLasers = R"(lasers:
+  - {dist_correction: 0.01, laser_id: 1, rot_correction: 0.002, vert_correction: 0.0174532925, vert_offset_correction: -0.0007, horiz_offset_correction: 0.001}
+  - {laser_id: 0, vert_correction: -0.261799388}
+)";
+
+std::string sixteen_lasers(const std::string& replace_laser_7 = "") {
+  std::string yaml = "lasers:\n";
+  for (int i = 0; i < 16; ++i) {
+    yaml += i == 7 && !replace_laser_7.empty()
+                ? replace_laser_7
+                : "  - {laser_id: " + std::to_string(i) + ", vert_correction: " + std::to_string((i % 2 ? 1 : -1) * 0.01 * i) +
+                      ", rot_correction: 0.0}\n";
+  }
+  return yaml;
+}
+
+TEST(Vlp16Calibration, YamlFieldsAreReadByLaserId) {
+  const Calibration c = parse_calibration_yaml(sixteen_lasers("  - {laser_id: 7, vert_correction: 0.12, rot_correction: "
+                                                              "-0.001, vert_offset_correction: 0.005, "
+                                                              "horiz_offset_correction: 0.002, dist_correction: 0.03}\n"),
+                                               "cal.yaml");
+  EXPECT_DOUBLE_EQ(c.lasers[7].vert_angle_rad, 0.12);
+  EXPECT_DOUBLE_EQ(c.lasers[7].rot_correction_rad, -0.001);
+  EXPECT_DOUBLE_EQ(c.lasers[7].vert_offset_m, 0.005);
+  EXPECT_DOUBLE_EQ(c.lasers[7].horiz_offset_m, 0.002);
+  EXPECT_DOUBLE_EQ(c.lasers[7].dist_correction_m, 0.03);
+  EXPECT_DOUBLE_EQ(c.lasers[6].vert_angle_rad, -0.06);
+}
+
+TEST(Vlp16Calibration, NebulaFileMatchesTheManualAngles) {
+  TRAJROI_REQUIRE_DATA(path, "velodyne/vlp16/nebula_VLP16_calibration.yaml");
+  const Calibration c = parse_calibration_yaml(test::read_file(path), path.string());
+  const Calibration manual = Calibration::vlp16_default();
+  for (std::size_t i = 0; i < kLasers; ++i) {
+    EXPECT_NEAR(c.lasers[i].vert_angle_rad, manual.lasers[i].vert_angle_rad, 1e-12) << i;
+    EXPECT_EQ(c.lasers[i].vert_offset_m, 0.0);
+  }
+  // Rings by elevation: −15° … −1° are the even lasers, +1° … +15° the odd ones.
+  const auto rings = c.rings();
+  for (std::size_t i = 0; i < kLasers; ++i) EXPECT_EQ(rings[i], i % 2 == 0 ? i / 2 : 8 + i / 2) << i;
+}
+
+TEST(Vlp16Calibration, BadFilesNameTheProblem) {
+  const auto message = [](const std::string& yaml) {
+    try {
+      (void)parse_calibration_yaml(yaml, "cal.yaml");
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  EXPECT_EQ(message(kTwoLasers), "cal.yaml: 'lasers' has 2 entries; a VLP-16 has 16");
+  EXPECT_EQ(message("foo: 1\n"), "cal.yaml: no 'lasers' list");
+  EXPECT_NE(message("lasers: [\n").find("cal.yaml: line"), std::string::npos);
+  EXPECT_EQ(message(sixteen_lasers("  - {laser_id: 3, vert_correction: 0.1}\n")), "cal.yaml: laser_id 3 appears twice");
+  EXPECT_EQ(message(sixteen_lasers("  - {laser_id: 7}\n")), "cal.yaml: laser entry 7 has no 'vert_correction'");
+  EXPECT_EQ(message(sixteen_lasers("  - {laser_id: 7, vert_correction: abc}\n")),
+            "cal.yaml: laser entry 7: 'vert_correction' is not a number");
+  EXPECT_EQ(message(sixteen_lasers("  - {laser_id: 16, vert_correction: 0.1}\n")),
+            "cal.yaml: laser entry 7: laser_id 16.000000 is not 0 … 15");
+  EXPECT_EQ(message(sixteen_lasers("  - {laser_id: 7, vert_correction: 15}\n")),
+            "cal.yaml: laser_id 7: vert_correction is not an angle in radians");
+}
+
+// Corrections follow the velodyne model: θ = azimuth − rot_correction, range + dist_correction,
+// horizontal offset across the beam.
+TEST(Vlp16Calibration, CorrectionsEnterTheGeometry) {
+  Calibration c = Calibration::vlp16_default();
+  c.lasers[2] = LaserCalibration{0.1, 0.05, 0.0, 0.02, 0.3};
+  auto p = make_packet(9000, 40, ReturnMode::kStrongest);
+  set_return(p, 0, 2, 5000, 1);  // 10 m, azimuth 90° + 2 × 2.304 / 110.592 × 0.4°
+  std::vector<Point> points;
+  PacketDecoder(c).decode(p, points);
+  ASSERT_EQ(points.size(), 1u);
+  const double range = 10.3;
+  const double theta = (90.0 + 0.4 * 2 * 2.304 / 110.592) * std::numbers::pi / 180.0 - 0.05;
+  const double r_xy = range * std::cos(0.1);
+  EXPECT_NEAR(points[0].x, r_xy * std::cos(theta) + 0.02 * std::sin(theta), 1e-5);
+  EXPECT_NEAR(points[0].y, -r_xy * std::sin(theta) + 0.02 * std::cos(theta), 1e-5);
+  EXPECT_NEAR(points[0].z, range * std::sin(0.1), 1e-5);
+  EXPECT_FLOAT_EQ(points[0].distance_m, 10.3f);
+}
+
+// Random bytes with valid framing: whatever the distances and azimuths, the decoder stays in
+// bounds and accounts for every return (run under ASan/UBSan by the test script).
+TEST(Vlp16Decoder, RandomPacketsAreDecodedWithinBoundsAndFullyAccounted) {
+  std::uint64_t state = 0x9E3779B97F4A7C15ull;
+  const auto random_byte = [&] {
+    state ^= state << 13;
+    state ^= state >> 7;
+    state ^= state << 17;
+    return static_cast<std::uint8_t>(state);
+  };
+  const PacketDecoder decoder(Calibration::vlp16_default(), DecodeOptions{0.5, 100.0});
+  std::vector<Point> points;
+  for (int n = 0; n < 2000; ++n) {
+    std::vector<std::uint8_t> p(kDataPacketBytes);
+    for (auto& b : p) b = random_byte();
+    for (std::size_t block = 0; block < kBlocks; ++block) {
+      p[block * 100] = 0xFF;
+      p[block * 100 + 1] = 0xEE;
+      p[block * 100 + 3] = static_cast<std::uint8_t>(p[block * 100 + 3] % 0x8C);  // azimuth < 35840
+    }
+    p[1204] = static_cast<std::uint8_t>(0x37 + n % 3);
+    p[1205] = 0x22;
+    ASSERT_EQ(validate_data_packet(p), PacketError::kNone);
+    points.clear();
+    const PacketDecoder::Result r = decoder.decode(p, points);
+    EXPECT_EQ(r.points + r.no_return + r.out_of_range + r.merged_returns, 384u);
+    for (const Point& point : points) {
+      ASSERT_TRUE(std::isfinite(point.x) && std::isfinite(point.y) && std::isfinite(point.z));
+      ASSERT_GE(point.azimuth_deg, 0.0f);
+      ASSERT_LT(point.azimuth_deg, 360.0f);
+      ASSERT_LE(point.distance_m, 100.0f);
+    }
+  }
 }
 
 }  // namespace

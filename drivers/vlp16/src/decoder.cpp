@@ -150,6 +150,8 @@ PacketDecoder::Result PacketDecoder::decode(std::span<const std::uint8_t> packet
       }
       double azimuth_cdeg = static_cast<double>(azimuth) + static_cast<double>(gap) * fraction;
       if (azimuth_cdeg >= kAzimuthLimit) azimuth_cdeg -= kAzimuthLimit;
+      float azimuth_deg = static_cast<float>(azimuth_cdeg / 100.0);
+      if (azimuth_deg >= 360.0f) azimuth_deg = 0.0f;  // 359.99999… rounds up in float
 
       const std::size_t laser_index = channel % kLasers;
       const Laser& laser = lasers_[laser_index];
@@ -171,7 +173,7 @@ PacketDecoder::Result PacketDecoder::decode(std::span<const std::uint8_t> packet
         p.y = static_cast<float>(-r_xy * sin_a + laser.horiz_offset_m * cos_a);
         p.z = static_cast<float>(range * laser.sin_vert + laser.vert_offset_m * laser.cos_vert);
         p.distance_m = static_cast<float>(range);
-        p.azimuth_deg = static_cast<float>(azimuth_cdeg / 100.0);
+        p.azimuth_deg = azimuth_deg;
         p.time_offset_ns = time_ns[channel];
         p.intensity = channel_reflectivity(packet, from_block, channel);
         p.laser = static_cast<std::uint8_t>(laser_index);
