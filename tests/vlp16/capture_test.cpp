@@ -386,6 +386,30 @@ TEST(Vlp16Capture, TruncatedCaptureDeliversEveryWholeRecordThenAnError) {
   std::filesystem::remove(cut);
 }
 
+// Pacing: × N replays the capture's own timing divided by N (never faster); a port filter
+// leaves the other datagrams out.
+TEST(Vlp16Capture, PacedReplayFollowsTheCaptureClockAndPortsFilter) {
+  TRAJROI_REQUIRE_DATA(path, "velodyne/vlp16/rust-lidar-utils_velodyne_vlp16_2014_productid0x21.pcap");
+  PcapOptions options;
+  options.speed = 5.0;
+  options.ports = {kDataPort};
+  PcapSource source(path, options);
+  Datagram datagram;
+  std::size_t delivered = 0;
+  std::int64_t first_ns = 0, last_ns = 0;
+  const auto start = std::chrono::steady_clock::now();
+  while (source.next(datagram) == PacketSource::Next::kDatagram) {
+    EXPECT_EQ(datagram.destination_port, kDataPort);
+    if (delivered++ == 0) first_ns = datagram.receive_time_ns;
+    last_ns = datagram.receive_time_ns;
+  }
+  const auto elapsed_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(delivered, 84u);
+  EXPECT_EQ(source.skipped_records(), 16u);  // the position packets
+  EXPECT_GE(elapsed_ns, (last_ns - first_ns) / 5);  // 0.110 s of capture at × 5
+  EXPECT_THROW(PcapSource(path, PcapOptions{{kDataPort}, -1.0}), std::invalid_argument);
+}
+
 TEST(Vlp16Capture, UnreadableFileIsAClearError) {
   try {
     PcapSource source("/nonexistent/capture.pcap");

@@ -32,7 +32,10 @@ ModelCheck::Verdict ModelCheck::check(std::span<const std::uint8_t> packet) noex
   const std::uint8_t id = product_id(packet);
   if (id == kProductVlp16) return Verdict::kVlp16;
   if (id != kProductHdl32e) {
-    reason_ = "product id " + hex_id(id) + " (" + std::string(product_name(id)) + ") is not supported";
+    if (id != rejected_id_ || reason_.empty()) {  // built once per model, not per packet
+      reason_ = "product id " + hex_id(id) + " (" + std::string(product_name(id)) + ") is not supported";
+      rejected_id_ = id;
+    }
     return Verdict::kRejected;
   }
   if (early_ == Early::kVlp16) return Verdict::kVlp16;
@@ -50,6 +53,7 @@ ModelCheck::Verdict ModelCheck::check(std::span<const std::uint8_t> packet) noex
     if (++inconclusive_ < kMaxUndecided) return Verdict::kUndecided;
     early_ = Early::kHdl32e;
     reason_ = "product id 0x21 (HDL-32E) with no usable packet timing is not supported";
+    rejected_id_ = kProductHdl32e;
     return Verdict::kRejected;
   }
   measured_period_us_ = static_cast<std::uint32_t>(delta);
@@ -75,6 +79,7 @@ ModelCheck::Verdict ModelCheck::check(std::span<const std::uint8_t> packet) noex
                 "(a VLP-16 sends one every %.0f µs, 0.4° per firing at 10 Hz)",
                 measured_period_us_, step_cdeg / 100.0, period_us);
   reason_ = text;
+  rejected_id_ = kProductHdl32e;
   return Verdict::kRejected;
 }
 

@@ -41,6 +41,7 @@ class ModelCheck {
   std::uint8_t previous_mode_ = 0;
   unsigned inconclusive_ = 0;
   std::uint32_t measured_period_us_ = 0;
+  std::uint8_t rejected_id_ = 0;
   std::string reason_;
 };
 
