@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <ctime>
+#include <limits>
 
 #include "packet_builder.hpp"
 
@@ -53,6 +54,10 @@ TEST(Vlp16Udp, DataAndPositionDatagramsArriveWholeWithKernelTimes) {
   ASSERT_NE(source.data_port(), 0);
   ASSERT_NE(source.position_port(), 0);
   EXPECT_GT(source.granted_receive_buffer_bytes(), 0);
+  // Linux reports twice the usable size; a warning exactly when that is below the request.
+  EXPECT_EQ(source.receive_buffer_warning().empty(),
+            source.granted_receive_buffer_bytes() / 2 >= source.requested_receive_buffer_bytes())
+      << source.receive_buffer_warning();
   const Sender sender;
   constexpr std::size_t kPackets = 100;
   const std::int64_t before = realtime_ns();
@@ -84,6 +89,14 @@ TEST(Vlp16Udp, DataAndPositionDatagramsArriveWholeWithKernelTimes) {
   EXPECT_EQ(position, 1u);
   EXPECT_EQ(source.truncated(), 0u);
   EXPECT_EQ(source.next(datagram, std::chrono::milliseconds(10)), PacketSource::Next::kTimeout);
+}
+
+TEST(Vlp16Udp, AnUngrantableBufferIsWarnedAbout) {
+  UdpOptions options = loopback();
+  options.receive_buffer_bytes = std::numeric_limits<int>::max();  // more than a socket can have
+  UdpSource source(options);
+  EXPECT_LT(source.granted_receive_buffer_bytes() / 2, options.receive_buffer_bytes);
+  EXPECT_NE(source.receive_buffer_warning().find("net.core.rmem_max"), std::string::npos);
 }
 
 TEST(Vlp16Udp, OversizedDatagramIsCountedAsTruncated) {

@@ -82,6 +82,14 @@ void UdpSource::open_socket(Socket& socket, std::uint16_t port, bool data) {
   socket.iovecs.assign(batch, iovec{});
 }
 
+std::string UdpSource::receive_buffer_warning() const {
+  if (granted_ / 2 >= options_.receive_buffer_bytes) return {};
+  return "UDP port " + std::to_string(sockets_[0].port) + ": SO_RCVBUF " + std::to_string(granted_ / 2) +
+         " bytes granted, " + std::to_string(options_.receive_buffer_bytes) +
+         " asked for; raise net.core.rmem_max (sysctl) or give the service CAP_NET_ADMIN, or packets may be "
+         "dropped under load";
+}
+
 bool UdpSource::receive_batch(Socket& socket) {
   for (std::size_t i = 0; i < options_.batch; ++i) {
     socket.iovecs[i] = iovec{socket.buffers.data() + i * kBufferBytes, kBufferBytes};

@@ -40,6 +40,8 @@ class UdpSource final : public PacketSource {
   // usable size). Below the request, net.core.rmem_max is too small: the caller warns.
   [[nodiscard]] int granted_receive_buffer_bytes() const noexcept { return granted_; }
   [[nodiscard]] int requested_receive_buffer_bytes() const noexcept { return options_.receive_buffer_bytes; }
+  // A message for the caller to log when the kernel granted less than asked, else empty.
+  [[nodiscard]] std::string receive_buffer_warning() const;
   // The ports actually bound (useful with port 0, which lets the kernel choose).
   [[nodiscard]] std::uint16_t data_port() const noexcept { return sockets_[0].port; }
   [[nodiscard]] std::uint16_t position_port() const noexcept { return sockets_[1].port; }
