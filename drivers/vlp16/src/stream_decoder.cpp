@@ -165,13 +165,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   const std::uint32_t span_cdeg = azimuth_gap(first_azimuth, block_azimuth(packet, last_firing_block));
   rate_cdeg_per_us_ = static_cast<double>(span_cdeg) / (static_cast<double>(kBlocks / step - 1) * kBlockDuration_us);
 
-  scratch_.clear();
-  const PacketDecoder::Result r = decoder_.decode(packet, scratch_);
-  ++counters_.decoded_packets;
-  counters_.points += r.points;
-  counters_.no_return += r.no_return;
-  counters_.out_of_range += r.out_of_range;
-  counters_.merged_returns += r.merged_returns;
+  decode_to_scratch(packet);
   product_id_ = vlp16::product_id(packet);
   return_mode_ = mode;
 
@@ -204,11 +198,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   if (!counted) ++frame_.packets;
 }
 
-void StreamDecoder::append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns) {
-  if (frame_.points.empty() || packet_time_ns < frame_.start_time_ns) {
-    ++counters_.late_dropped;
-    return;
-  }
+void StreamDecoder::decode_to_scratch(std::span<const std::uint8_t> packet) {
   scratch_.clear();
   const PacketDecoder::Result r = decoder_.decode(packet, scratch_);
   ++counters_.decoded_packets;
@@ -216,6 +206,14 @@ void StreamDecoder::append_late(std::span<const std::uint8_t> packet, std::int64
   counters_.no_return += r.no_return;
   counters_.out_of_range += r.out_of_range;
   counters_.merged_returns += r.merged_returns;
+}
+
+void StreamDecoder::append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns) {
+  if (frame_.points.empty() || packet_time_ns < frame_.start_time_ns) {
+    ++counters_.late_dropped;
+    return;
+  }
+  decode_to_scratch(packet);
   ++frame_.packets;
   for (const Point& point : scratch_) {
     const std::int64_t t = packet_time_ns + point.time_offset_ns;

@@ -108,6 +108,7 @@ class StreamDecoder {
 
  private:
   void accept(std::span<const std::uint8_t> packet, std::int64_t receive_time_ns, FrameSink& sink);
+  void decode_to_scratch(std::span<const std::uint8_t> packet);  // and count what it held
   void append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns);
   std::int64_t packet_time_ns(std::uint32_t toh_us, std::int64_t receive_time_ns, double period_us);
   void finish_frame(FrameSink& sink, bool partial);
