@@ -36,6 +36,7 @@ struct Replay {
   Collector frames;
   StreamCounters counters;
   std::string model_rejection;
+  std::uint32_t model_period_us = 0;  // that decided a 0x21 stream
   std::optional<PositionPacket> first_rmc, last_rmc;
 };
 
@@ -67,7 +68,8 @@ Replay replay(const std::filesystem::path& path, const Calibration& calibration 
   EXPECT_EQ(next, PacketSource::Next::kEnd) << source.error();
   decoder.flush(r.frames);
   r.counters = decoder.counters();
-  r.model_rejection = decoder.model_rejection();
+  r.model_rejection = decoder.model_check().reason();
+  r.model_period_us = decoder.model_check().measured_period_us();
   r.first_rmc = decoder.first_rmc();
   r.last_rmc = decoder.last_rmc();
   return r;
@@ -144,6 +146,9 @@ TEST(Vlp16Capture, EarlyFirmwareProductId0x21WithVlp16TimingDecodesAsVlp16) {
   EXPECT_EQ(r.position_datagrams, 16u);
   EXPECT_EQ(r.counters.rejected_total(), 0u) << r.model_rejection;
   EXPECT_EQ(r.counters.decoded_packets, 84u);  // the held first packet included
+  // Decided on a VLP-16 single-return period (README: TOH step 1327/1328 µs).
+  EXPECT_GE(r.model_period_us, 1327u);
+  EXPECT_LE(r.model_period_us, 1328u);
   EXPECT_GT(r.counters.points, 0u);
   EXPECT_EQ(r.counters.lost_packets, 0u);
   EXPECT_EQ(r.wraps, 1u);

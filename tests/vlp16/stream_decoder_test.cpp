@@ -62,7 +62,7 @@ Outcome run(Sensor sensor, std::size_t count, StreamOptions options = {},
   }
   decoder.flush(r.sink);
   r.counters = decoder.counters();
-  r.rejection = decoder.model_rejection();
+  r.rejection = decoder.model_check().reason();
   return r;
 }
 

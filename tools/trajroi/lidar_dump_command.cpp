@@ -1,6 +1,7 @@
 // `trajroi lidar-dump`: replays a Velodyne pcap through the VLP-16 stream decoder and
 // reports what it holds (packets, rejections, model, frames, loss, GPRMC), optionally every
 // point as CSV.
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cinttypes>
@@ -160,7 +161,11 @@ void run_lidar_dump(const LidarDumpOptions& o) {
 
   const StreamCounters& c = decoder.counters();
   std::optional<std::uint8_t> product = decoder.product_id();
-  if (!product && !product_ids.empty()) product = product_ids.rbegin()->first;
+  if (!product && !product_ids.empty()) {  // none decoded: the id most packets carried
+    product = std::max_element(product_ids.begin(), product_ids.end(), [](const auto& a, const auto& b) {
+                return a.second < b.second;
+              })->first;
+  }
   const std::string model = c.decoded_packets > 0 ? "VLP-16" : product ? std::string(product_name(*product)) : "";
 
   if (o.json) {
@@ -178,7 +183,7 @@ void run_lidar_dump(const LidarDumpOptions& o) {
         ", \"duplicates\": %" PRIu64 ", \"skipped_records\": %" PRIu64 ", \"gprmc\": {\"first\": %s, \"last\": %s}, "
         "\"read_error\": %s}\n",
         json_string(o.capture).c_str(), c.data_packets, c.position_packets, rejected.c_str(),
-        c.rejected_total() > 0 && !decoder.model_rejection().empty() ? json_string(decoder.model_rejection()).c_str()
+        c.rejected_total() > 0 && !decoder.model_check().reason().empty() ? json_string(decoder.model_check().reason()).c_str()
                                                                       : "null",
         model.empty() ? "null" : json_string(model).c_str(),
         product ? json_string(hex_byte(*product)).c_str() : "null",
@@ -195,7 +200,7 @@ void run_lidar_dump(const LidarDumpOptions& o) {
         std::printf("    %-22s %" PRIu64 "\n", std::string(to_string(static_cast<PacketError>(e))).c_str(), c.rejected[e]);
       }
     }
-    if (!decoder.model_rejection().empty() && c.rejected_total() > 0) std::printf("    %s\n", decoder.model_rejection().c_str());
+    if (!decoder.model_check().reason().empty() && c.rejected_total() > 0) std::printf("    %s\n", decoder.model_check().reason().c_str());
     std::printf("  model             %s%s\n", model.empty() ? "-" : model.c_str(),
                 product ? (" (product id " + hex_byte(*product) + ")").c_str() : "");
     std::printf("  return mode       %s\n", decoder.return_mode() ? return_mode_name(decoder.return_mode()).c_str() : "-");

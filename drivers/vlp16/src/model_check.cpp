@@ -24,10 +24,6 @@ std::string hex_id(std::uint8_t id) {
 
 }  // namespace
 
-void ModelCheck::reset() noexcept {
-  *this = ModelCheck{};
-}
-
 ModelCheck::Verdict ModelCheck::check(std::span<const std::uint8_t> packet) noexcept {
   const std::uint8_t id = product_id(packet);
   if (id == kProductVlp16) return Verdict::kVlp16;

@@ -31,7 +31,6 @@ class ModelCheck {
   [[nodiscard]] const std::string& reason() const noexcept { return reason_; }
   // Microseconds between the two 0x21 packets that decided, 0 before.
   [[nodiscard]] std::uint32_t measured_period_us() const noexcept { return measured_period_us_; }
-  void reset() noexcept;
 
  private:
   enum class Early : std::uint8_t { kUnknown, kVlp16, kHdl32e };

@@ -100,8 +100,9 @@ class StreamDecoder {
   // The product id and return mode of the last decoded packet.
   [[nodiscard]] std::optional<std::uint8_t> product_id() const noexcept { return product_id_; }
   [[nodiscard]] std::optional<ReturnMode> return_mode() const noexcept { return return_mode_; }
-  // Why the last packet rejected for its model was rejected; empty if none was.
-  [[nodiscard]] const std::string& model_rejection() const noexcept { return model_.reason(); }
+  // The model check: why the last packet rejected for its model was (reason(), empty if none
+  // was) and the packet period that decided a 0x21 stream.
+  [[nodiscard]] const ModelCheck& model_check() const noexcept { return model_; }
   [[nodiscard]] const std::optional<PositionPacket>& first_rmc() const noexcept { return first_rmc_; }
   [[nodiscard]] const std::optional<PositionPacket>& last_rmc() const noexcept { return last_rmc_; }
   [[nodiscard]] const TopOfHourClock& utc_clock() const noexcept { return utc_clock_; }
