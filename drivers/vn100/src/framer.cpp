@@ -1,6 +1,8 @@
 #include "trajroi/vn100/framer.hpp"
 
 #include <bit>
+#include <stdexcept>
+#include <string>
 
 #include "trajroi/framing/little_endian.hpp"
 
@@ -61,6 +63,27 @@ std::optional<Layout> parse_layout(std::span<const std::uint8_t> frame) noexcept
     layout.fields[g] = mask;
   }
   return layout;
+}
+
+std::vector<std::uint8_t> encode_frame(const std::array<std::uint16_t, 8>& group_fields,
+                                       std::span<const std::uint8_t> payload) {
+  std::vector<std::uint8_t> frame{kSync, 0};
+  for (std::size_t g = 0; g < group_fields.size(); ++g) {
+    if (group_fields[g] == 0) continue;
+    frame[1] = static_cast<std::uint8_t>(frame[1] | (1U << g));
+    framing::put_le_u16(frame, group_fields[g]);
+  }
+  const std::optional<Layout> layout = parse_layout(frame);
+  if (!layout) throw std::invalid_argument("VN-100 frame: field selection cannot be sized");
+  if (layout->payload_bytes != payload.size()) {
+    throw std::invalid_argument("VN-100 frame: payload of " + std::to_string(payload.size()) + " bytes, layout needs " +
+                                std::to_string(layout->payload_bytes));
+  }
+  for (const std::uint8_t b : payload) frame.push_back(b);
+  const std::uint16_t crc = crc16_ccitt(std::span<const std::uint8_t>(frame).subspan(1));
+  frame.push_back(static_cast<std::uint8_t>(crc >> 8));
+  frame.push_back(static_cast<std::uint8_t>(crc & 0xFF));
+  return frame;
 }
 
 framing::Verdict Protocol::inspect(std::span<const std::uint8_t> bytes) const noexcept {

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <vector>
 
 #include "trajroi/framing/stream_framer.hpp"
 
@@ -43,6 +44,12 @@ struct Layout {
 // The layout of the header at the start of `frame` (sync included), or nothing when the
 // header is incomplete or cannot be sized.
 [[nodiscard]] std::optional<Layout> parse_layout(std::span<const std::uint8_t> frame) noexcept;
+
+// A whole frame: sync, group byte, the masks of the groups present in `group_fields` (index =
+// group − 1), `payload` and the CRC. Throws std::invalid_argument when the payload size does
+// not match the layout the masks describe or the layout cannot be sized.
+[[nodiscard]] std::vector<std::uint8_t> encode_frame(const std::array<std::uint16_t, 8>& group_fields,
+                                                     std::span<const std::uint8_t> payload);
 
 class Protocol {
  public:
