@@ -1,0 +1,118 @@
+#pragma once
+
+// The robot's pose over time: GNSS fixes (antenna position in the global frame, with their
+// quality) and attitudes (global_from_robot rotations), each ordered by host time in ns.
+// pose_at(t) interpolates (position linear, attitude slerp) between the samples around t,
+// extrapolates at most a configured bound past the newest one, and otherwise answers
+// "no valid pose" with the reason — it never hands out a stale or low-quality pose silently.
+//
+// The robot origin is placed from the antenna with the lever arm:
+//   p_global_robot = p_global_antenna − R_global_robot · p_robot_antenna.
+//
+// Storage is preallocated (capacity per stream); the oldest samples are dropped first.
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+namespace trajroi::pose {
+
+// Quality of a GNSS fix, as the receiver reported it (u-blox NAV-PVT semantics).
+struct FixQuality {
+  std::uint8_t fix_type = 0;    // 0 none, 1 DR, 2 2-D, 3 3-D, 4 GNSS+DR, 5 time only
+  bool gnss_fix_ok = false;
+  double h_acc_m = 1e9;
+  bool rtk_fixed = false;       // carrier solution fixed
+  bool rtk_float = false;
+};
+
+struct GnssFix {
+  std::int64_t t_ns = 0;                     // host monotonic time of the epoch
+  Eigen::Vector3d antenna_global_m = Eigen::Vector3d::Zero();
+  FixQuality quality;
+};
+
+struct AttitudeSample {
+  std::int64_t t_ns = 0;
+  Eigen::Quaterniond global_from_robot = Eigen::Quaterniond::Identity();
+};
+
+struct PoseGate {
+  std::uint8_t min_fix_type = 3;           // 3-D (4 = GNSS + dead reckoning also passes)
+  bool require_gnss_fix_ok = true;
+  double max_h_acc_m = 0.5;
+  bool require_rtk_fixed = false;
+  std::int64_t max_extrapolation_ns = 100'000'000;  // past the newest sample of each stream
+  std::int64_t max_gap_ns = 1'000'000'000;          // between the two samples bracketing t
+};
+
+enum class PoseStatus : std::uint8_t {
+  kValid,
+  kNoGnss,             // no fix at all yet
+  kNoAttitude,         // no attitude at all yet
+  kBeforeFirstSample,  // t precedes the oldest sample kept
+  kGnssTooOld,         // t is past the newest fix by more than max_extrapolation_ns
+  kAttitudeTooOld,
+  kGnssGap,            // the fixes around t are further apart than max_gap_ns
+  kAttitudeGap,
+  kFixTypeTooLow,      // a fix used fails the gate …
+  kNoGnssFixOk,
+  kAccuracyTooLow,
+  kNotRtkFixed,
+};
+[[nodiscard]] std::string_view to_string(PoseStatus status) noexcept;
+
+struct PoseQuery {
+  PoseStatus status = PoseStatus::kNoGnss;
+  Eigen::Isometry3d global_from_robot = Eigen::Isometry3d::Identity();  // valid only if kValid
+  [[nodiscard]] bool valid() const noexcept { return status == PoseStatus::kValid; }
+};
+
+// Counts of samples refused on insertion.
+struct PoseBufferCounters {
+  std::uint64_t fixes = 0;
+  std::uint64_t attitudes = 0;
+  std::uint64_t out_of_order = 0;   // older than or as old as the newest sample of its stream
+  std::uint64_t non_finite = 0;     // NaN / infinite values
+};
+
+class PoseBuffer {
+ public:
+  // `capacity` samples per stream (at least 2). Throws std::invalid_argument for a gate
+  // with negative bounds or a capacity below 2.
+  PoseBuffer(const PoseGate& gate, const Eigen::Vector3d& antenna_in_robot_m, std::size_t capacity = 256);
+
+  // Samples must arrive in increasing time per stream; others are refused and counted.
+  bool add_fix(const GnssFix& fix) noexcept;
+  bool add_attitude(const AttitudeSample& attitude) noexcept;
+
+  [[nodiscard]] PoseQuery pose_at(std::int64_t t_ns) const noexcept;
+
+  [[nodiscard]] const PoseBufferCounters& counters() const noexcept { return counters_; }
+  [[nodiscard]] const PoseGate& gate() const noexcept { return gate_; }
+
+ private:
+  template <class T>
+  struct Ring {
+    std::vector<T> items;
+    std::size_t head = 0;  // index of the oldest
+    std::size_t size = 0;
+    [[nodiscard]] const T& at(std::size_t i) const noexcept { return items[(head + i) % items.size()]; }
+    [[nodiscard]] const T& newest() const noexcept { return at(size - 1); }
+    void push(const T& item) noexcept;
+    // Index of the last sample with time ≤ t, or size when t precedes every sample.
+    [[nodiscard]] std::size_t floor(std::int64_t t_ns) const noexcept;
+  };
+
+  [[nodiscard]] PoseStatus check(const FixQuality& q) const noexcept;
+
+  PoseGate gate_;
+  Eigen::Vector3d antenna_in_robot_m_;
+  Ring<GnssFix> fixes_;
+  Ring<AttitudeSample> attitudes_;
+  PoseBufferCounters counters_;
+};
+
+}  // namespace trajroi::pose

@@ -1,0 +1,185 @@
+#include "trajroi/pose/pose_buffer.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace trajroi::pose {
+
+std::string_view to_string(PoseStatus status) noexcept {
+  switch (status) {
+    case PoseStatus::kValid: return "valid";
+    case PoseStatus::kNoGnss: return "no GNSS fix yet";
+    case PoseStatus::kNoAttitude: return "no attitude yet";
+    case PoseStatus::kBeforeFirstSample: return "time precedes the oldest pose sample";
+    case PoseStatus::kGnssTooOld: return "newest GNSS fix too old (beyond the extrapolation limit)";
+    case PoseStatus::kAttitudeTooOld: return "newest attitude too old (beyond the extrapolation limit)";
+    case PoseStatus::kGnssGap: return "gap between GNSS fixes too long";
+    case PoseStatus::kAttitudeGap: return "gap between attitudes too long";
+    case PoseStatus::kFixTypeTooLow: return "GNSS fix type below the gate";
+    case PoseStatus::kNoGnssFixOk: return "GNSS fix not flagged gnssFixOK";
+    case PoseStatus::kAccuracyTooLow: return "GNSS horizontal accuracy worse than the gate";
+    case PoseStatus::kNotRtkFixed: return "GNSS carrier solution not fixed (RTK fixed required)";
+  }
+  return "unknown";
+}
+
+template <class T>
+void PoseBuffer::Ring<T>::push(const T& item) noexcept {
+  if (size < items.size()) {
+    items[(head + size) % items.size()] = item;
+    ++size;
+  } else {
+    items[head] = item;
+    head = (head + 1) % items.size();
+  }
+}
+
+template <class T>
+std::size_t PoseBuffer::Ring<T>::floor(std::int64_t t_ns) const noexcept {
+  if (size == 0 || t_ns < at(0).t_ns) return size;
+  std::size_t lo = 0;
+  std::size_t hi = size - 1;  // invariant: at(lo).t_ns ≤ t
+  while (lo < hi) {
+    const std::size_t mid = lo + (hi - lo + 1) / 2;
+    if (at(mid).t_ns <= t_ns) {
+      lo = mid;
+    } else {
+      hi = mid - 1;
+    }
+  }
+  return lo;
+}
+
+PoseBuffer::PoseBuffer(const PoseGate& gate, const Eigen::Vector3d& antenna_in_robot_m, std::size_t capacity)
+    : gate_(gate), antenna_in_robot_m_(antenna_in_robot_m) {
+  if (capacity < 2) throw std::invalid_argument("pose buffer: capacity must be at least 2 samples");
+  if (gate.max_extrapolation_ns < 0 || gate.max_gap_ns <= 0 || !(gate.max_h_acc_m > 0)) {
+    throw std::invalid_argument("pose gate: extrapolation must be ≥ 0, gap and accuracy bounds > 0");
+  }
+  if (!antenna_in_robot_m.allFinite()) throw std::invalid_argument("pose buffer: antenna lever arm is not finite");
+  fixes_.items.resize(capacity);
+  attitudes_.items.resize(capacity);
+}
+
+bool PoseBuffer::add_fix(const GnssFix& fix) noexcept {
+  if (!fix.antenna_global_m.allFinite() || std::isnan(fix.quality.h_acc_m)) {
+    ++counters_.non_finite;
+    return false;
+  }
+  if (fixes_.size > 0 && fix.t_ns <= fixes_.newest().t_ns) {
+    ++counters_.out_of_order;
+    return false;
+  }
+  fixes_.push(fix);
+  ++counters_.fixes;
+  return true;
+}
+
+bool PoseBuffer::add_attitude(const AttitudeSample& a) noexcept {
+  if (!a.global_from_robot.coeffs().allFinite() || a.global_from_robot.norm() < 1e-6) {
+    ++counters_.non_finite;
+    return false;
+  }
+  if (attitudes_.size > 0 && a.t_ns <= attitudes_.newest().t_ns) {
+    ++counters_.out_of_order;
+    return false;
+  }
+  AttitudeSample normalized = a;
+  normalized.global_from_robot.normalize();
+  attitudes_.push(normalized);
+  ++counters_.attitudes;
+  return true;
+}
+
+PoseStatus PoseBuffer::check(const FixQuality& q) const noexcept {
+  if (q.fix_type < gate_.min_fix_type || q.fix_type == 5) return PoseStatus::kFixTypeTooLow;  // 5: time only
+  if (gate_.require_gnss_fix_ok && !q.gnss_fix_ok) return PoseStatus::kNoGnssFixOk;
+  if (!(q.h_acc_m <= gate_.max_h_acc_m)) return PoseStatus::kAccuracyTooLow;
+  if (gate_.require_rtk_fixed && !q.rtk_fixed) return PoseStatus::kNotRtkFixed;
+  return PoseStatus::kValid;
+}
+
+PoseQuery PoseBuffer::pose_at(std::int64_t t_ns) const noexcept {
+  PoseQuery out;
+  if (fixes_.size == 0) {
+    out.status = PoseStatus::kNoGnss;
+    return out;
+  }
+  if (attitudes_.size == 0) {
+    out.status = PoseStatus::kNoAttitude;
+    return out;
+  }
+
+  // Position of the antenna.
+  Eigen::Vector3d antenna;
+  const std::size_t f = fixes_.floor(t_ns);
+  if (f == fixes_.size) {
+    out.status = PoseStatus::kBeforeFirstSample;
+    return out;
+  }
+  const GnssFix& a = fixes_.at(f);
+  if (PoseStatus s = check(a.quality); s != PoseStatus::kValid) {
+    out.status = s;
+    return out;
+  }
+  if (f + 1 < fixes_.size) {
+    const GnssFix& b = fixes_.at(f + 1);
+    if (b.t_ns - a.t_ns > gate_.max_gap_ns) {
+      out.status = PoseStatus::kGnssGap;
+      return out;
+    }
+    if (PoseStatus s = check(b.quality); s != PoseStatus::kValid) {
+      out.status = s;
+      return out;
+    }
+    const double w = static_cast<double>(t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
+    antenna = a.antenna_global_m + w * (b.antenna_global_m - a.antenna_global_m);
+  } else {
+    const std::int64_t ahead = t_ns - a.t_ns;
+    if (ahead > gate_.max_extrapolation_ns) {
+      out.status = PoseStatus::kGnssTooOld;
+      return out;
+    }
+    antenna = a.antenna_global_m;
+    // Linear extrapolation from the last two fixes when they are close enough and both pass.
+    if (f > 0 && ahead > 0) {
+      const GnssFix& prev = fixes_.at(f - 1);
+      if (a.t_ns - prev.t_ns <= gate_.max_gap_ns && check(prev.quality) == PoseStatus::kValid) {
+        const Eigen::Vector3d velocity = (a.antenna_global_m - prev.antenna_global_m) / static_cast<double>(a.t_ns - prev.t_ns);
+        antenna += velocity * static_cast<double>(ahead);
+      }
+    }
+  }
+
+  // Attitude.
+  Eigen::Quaterniond attitude;
+  const std::size_t r = attitudes_.floor(t_ns);
+  if (r == attitudes_.size) {
+    out.status = PoseStatus::kBeforeFirstSample;
+    return out;
+  }
+  const AttitudeSample& qa = attitudes_.at(r);
+  if (r + 1 < attitudes_.size) {
+    const AttitudeSample& qb = attitudes_.at(r + 1);
+    if (qb.t_ns - qa.t_ns > gate_.max_gap_ns) {
+      out.status = PoseStatus::kAttitudeGap;
+      return out;
+    }
+    const double w = static_cast<double>(t_ns - qa.t_ns) / static_cast<double>(qb.t_ns - qa.t_ns);
+    attitude = qa.global_from_robot.slerp(w, qb.global_from_robot);
+  } else {
+    if (t_ns - qa.t_ns > gate_.max_extrapolation_ns) {
+      out.status = PoseStatus::kAttitudeTooOld;
+      return out;
+    }
+    attitude = qa.global_from_robot;  // held within the bound
+  }
+
+  out.global_from_robot = Eigen::Isometry3d::Identity();
+  out.global_from_robot.linear() = attitude.toRotationMatrix();
+  out.global_from_robot.translation() = antenna - attitude * antenna_in_robot_m_;
+  out.status = PoseStatus::kValid;
+  return out;
+}
+
+}  // namespace trajroi::pose
