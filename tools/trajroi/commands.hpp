@@ -8,5 +8,6 @@ namespace trajroi::cli {
 void add_eval_commands(CLI::App& app);
 void add_filter_command(CLI::App& app);
 void add_lidar_dump_command(CLI::App& app);
+void add_serial_dump_commands(CLI::App& app);  // gnss-dump, imu-dump
 
 }  // namespace trajroi::cli

@@ -10,6 +10,7 @@ int main(int argc, char** argv) {
   trajroi::cli::add_eval_commands(app);
   trajroi::cli::add_filter_command(app);
   trajroi::cli::add_lidar_dump_command(app);
+  trajroi::cli::add_serial_dump_commands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
