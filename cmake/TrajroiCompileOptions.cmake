@@ -15,3 +15,15 @@ function(trajroi_target_defaults target)
     target_compile_options(${target} PRIVATE -Werror)
   endif()
 endfunction()
+
+# trajroi_library(<name> SOURCES ... ) — a library target `trajroi_<name>` with the alias
+# `trajroi::<name>`, its `include/` folder public, and the defaults above.
+function(trajroi_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES" ${ARGN})
+  add_library(trajroi_${name} ${ARG_SOURCES})
+  add_library(trajroi::${name} ALIAS trajroi_${name})
+  target_include_directories(trajroi_${name} PUBLIC
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+  trajroi_target_defaults(trajroi_${name})
+endfunction()

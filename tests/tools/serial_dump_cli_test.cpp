@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cli_fixture.hpp"
+#include "numeric_csv.hpp"
 #include "test_data.hpp"
 
 namespace {
@@ -136,26 +137,6 @@ struct ImuCase {
 
 class ImuDumpCli : public Cli, public ::testing::WithParamInterface<ImuCase> {};
 
-std::vector<std::vector<double>> parse_csv(const std::string& text, std::vector<std::string>* header) {
-  std::vector<std::vector<double>> rows;
-  std::istringstream in(text);
-  std::string line;
-  std::getline(in, line);
-  if (header != nullptr) {
-    std::istringstream h(line);
-    for (std::string cell; std::getline(h, cell, ',');) header->push_back(cell.substr(cell.find_first_not_of(' ')));
-  }
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    std::istringstream cells(line);
-    for (std::string cell; std::getline(cells, cell, ',');) {
-      if (cell.find_first_not_of(" \r") != std::string::npos) row.push_back(std::stod(cell));
-    }
-    rows.push_back(row);
-  }
-  return rows;
-}
-
 TEST_P(ImuDumpCli, CsvEqualsTheAuthorsCsv) {
   const ImuCase& c = GetParam();
   TRAJROI_REQUIRE_DATA(raw, c.raw);
@@ -163,8 +144,8 @@ TEST_P(ImuDumpCli, CsvEqualsTheAuthorsCsv) {
   const CommandResult r = run("imu-dump --csv " + raw.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::vector<std::string> ours_header;
-  const auto ours = parse_csv(r.out, &ours_header);
-  const auto theirs = parse_csv(trajroi::test::read_file(reference), nullptr);
+  const auto ours = trajroi::test::read_numeric_csv(r.out, &ours_header);
+  const auto theirs = trajroi::test::read_numeric_csv(trajroi::test::read_file(reference));
   ASSERT_EQ(ours.size(), c.rows);
   // The author's columns, in order, and ours holding the same quantity.
   const std::vector<std::string> mapping{"mag_x", "mag_y", "mag_z", "accel_x", "accel_y", "accel_z", "gyro_x", "gyro_y",

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "numeric_csv.hpp"
 #include "test_data.hpp"
 #include "trajroi/vn100/decoder.hpp"
 #include "trajroi/vn100/framer.hpp"
@@ -59,22 +60,6 @@ std::vector<double> csv_order(const Sample& s) {
   add(s.mag_ned_gauss);
   add(s.accel_ned_mps2);
   return v;
-}
-
-std::vector<std::vector<double>> read_reference_csv(const std::string& text) {
-  std::vector<std::vector<double>> rows;
-  std::istringstream in(text);
-  std::string line;
-  std::getline(in, line);  // header
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    std::istringstream cells(line);
-    for (std::string cell; std::getline(cells, cell, ',');) {
-      if (cell.find_first_not_of(" \r") != std::string::npos) row.push_back(std::stod(cell));
-    }
-    rows.push_back(row);
-  }
-  return rows;
 }
 
 // The CSV prints 7 significant digits (%e): a decoded float agrees within 1e-6 relative.
@@ -151,7 +136,7 @@ TEST_P(VnCapture, DecodedValuesEqualTheAuthorsCsv) {
   TRAJROI_REQUIRE_DATA(raw_path, log.raw);
   TRAJROI_REQUIRE_DATA(csv_path, log.csv);
   const Parsed raw = parse(as_bytes(test::read_file(raw_path)));
-  const auto rows = read_reference_csv(test::read_file(csv_path));
+  const auto rows = test::read_numeric_csv(test::read_file(csv_path));
   ASSERT_EQ(rows.size() + (log.frame_without_row >= 0 ? 1 : 0), raw.samples.size() + log.junk_rows);
   std::size_t row = log.junk_rows;
   for (std::size_t frame = 0; frame < raw.samples.size(); ++frame) {

@@ -8,6 +8,8 @@
 #include <span>
 #include <string_view>
 
+#include "trajroi/framing/little_endian.hpp"
+
 namespace trajroi::vlp16 {
 
 inline constexpr std::size_t kDataPacketBytes = 1206;
@@ -41,13 +43,9 @@ enum class PacketError : std::uint8_t {
 inline constexpr std::size_t kPacketErrorCount = 6;
 [[nodiscard]] std::string_view to_string(PacketError error) noexcept;
 
-[[nodiscard]] inline std::uint16_t read_u16(std::span<const std::uint8_t> b, std::size_t at) noexcept {
-  return static_cast<std::uint16_t>(b[at] | (b[at + 1] << 8));
-}
-[[nodiscard]] inline std::uint32_t read_u32(std::span<const std::uint8_t> b, std::size_t at) noexcept {
-  return static_cast<std::uint32_t>(b[at]) | (static_cast<std::uint32_t>(b[at + 1]) << 8) |
-         (static_cast<std::uint32_t>(b[at + 2]) << 16) | (static_cast<std::uint32_t>(b[at + 3]) << 24);
-}
+// Little-endian readers shared with the serial protocols.
+inline constexpr auto& read_u16 = framing::le_u16;
+inline constexpr auto& read_u32 = framing::le_u32;
 
 // Field accessors; the packet must have been validated (validate_data_packet() == kNone).
 [[nodiscard]] inline std::uint16_t block_azimuth(std::span<const std::uint8_t> p, std::size_t block) noexcept {
