@@ -12,6 +12,7 @@
 
 #include "cli_fixture.hpp"
 #include "numeric_csv.hpp"
+#include "trajroi/serial/byte_log.hpp"
 #include "test_data.hpp"
 
 namespace {
@@ -104,6 +105,27 @@ TEST_F(Cli, GnssDumpOfPyubx2LogsPrintsTheirFixes) {
   EXPECT_NE(r.out.find("\"utc\": \"2021-12-04T11:34:59.000Z\""), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("\"lat\": 53.450722800, \"lon\": -2.240285500, \"height_m\": 91.184, \"hmsl_m\": 42.701, \"h_acc_m\": 1.491"),
             std::string::npos);
+}
+
+// A run recorded as .trjb (chunks of any size, with times) dumps exactly as the raw log.
+TEST_F(Cli, GnssDumpReadsRecordingsLikeRawLogs) {
+  TRAJROI_REQUIRE_DATA(log, "ublox/gpsd/ublox-neo-m8p.log");
+  const std::string bytes = trajroi::test::read_file(log);
+  const fs::path recording = dir_ / "m8p.trjb";
+  {
+    trajroi::serial::RecordingWriter writer(recording.string());
+    const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
+    for (std::size_t at = 0, n = 1; at < bytes.size(); at += n, n = n % 97 + 1) {
+      n = std::min(n, bytes.size() - at);
+      writer.write({std::span<const std::uint8_t>(data + at, n), static_cast<std::int64_t>(at) * 1000});
+    }
+  }
+  const CommandResult raw = run("gnss-dump --json " + log.string());
+  const CommandResult rec = run("gnss-dump --json " + recording.string());
+  ASSERT_EQ(raw.exit_code, 0) << raw.err;
+  ASSERT_EQ(rec.exit_code, 0) << rec.err;
+  // Identical apart from the file name.
+  EXPECT_EQ(raw.out.substr(raw.out.find("\"bytes\"")), rec.out.substr(rec.out.find("\"bytes\"")));
 }
 
 TEST_F(Cli, DumpsNameAMissingFile) {
