@@ -40,6 +40,21 @@ inline std::string json_string(std::string_view line, std::string_view key) {
   return std::string(line.substr(begin, line.find('"', begin) - begin));
 }
 
+// The text gpsd printed for `"key":` (a number as written, or a string without its quotes).
+inline std::string json_raw(std::string_view line, std::string_view key) {
+  std::string pattern(1, '"');
+  pattern.append(key).append("\":");
+  const std::size_t at = line.find(pattern);
+  if (at == std::string_view::npos) return {};
+  std::size_t begin = at + pattern.size();
+  std::size_t end = line.find_first_of(",}", begin);
+  if (line[begin] == '"') {
+    ++begin;
+    end = line.find('"', begin);
+  }
+  return std::string(line.substr(begin, end - begin));
+}
+
 inline std::vector<GpsdTpv> read_gpsd_tpv(const std::string& chk_text) {
   std::vector<GpsdTpv> out;
   std::istringstream in(chk_text);

@@ -4,13 +4,13 @@
 
 #include <cmath>
 #include <map>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "cli_fixture.hpp"
+#include "gpsd_chk.hpp"
 #include "numeric_csv.hpp"
 #include "trajroi/serial/byte_log.hpp"
 #include "test_data.hpp"
@@ -34,10 +34,10 @@ std::string field(const std::string& line, const std::string& key) {
 std::multimap<std::string, std::pair<std::string, std::string>> gpsd_positions(const std::string& chk) {
   std::multimap<std::string, std::pair<std::string, std::string>> out;
   std::istringstream in(chk);
-  const std::regex tpv(R"re("class":"TPV".*"time":"([^"]+)".*"lat":(-?[0-9.]+),"lon":(-?[0-9.]+))re");
   for (std::string line; std::getline(in, line);) {
-    std::smatch m;
-    if (std::regex_search(line, m, tpv)) out.emplace(m[1], std::make_pair(m[2].str(), m[3].str()));
+    if (line.rfind("{\"class\":\"TPV\"", 0) != 0) continue;
+    std::string lat = trajroi::test::json_raw(line, "lat");
+    if (!lat.empty()) out.emplace(trajroi::test::json_raw(line, "time"), std::make_pair(lat, trajroi::test::json_raw(line, "lon")));
   }
   return out;
 }
