@@ -102,7 +102,7 @@ void gnss_dump(const std::string& path, bool json) {
 // ---- imu-dump -----------------------------------------------------------------------------------
 
 struct Column {
-  const char* name;
+  std::string name;
   std::function<bool(const vn100::Sample&)> present;
   std::function<double(const vn100::Sample&)> value;
 };
@@ -111,15 +111,15 @@ double f(float v) { return static_cast<double>(v); }
 
 // accel/gyro/mag: the compensated value when the frame carries it, else the uncompensated one.
 template <std::size_t N>
-Column pick(const char* name, vn100::Field comp, vn100::Field uncomp, std::array<float, N> vn100::Sample::*comp_member,
+Column pick(std::string name, vn100::Field comp, vn100::Field uncomp, std::array<float, N> vn100::Sample::*comp_member,
             std::array<float, N> vn100::Sample::*uncomp_member, std::size_t i) {
-  return {name, [=](const vn100::Sample& s) { return s.has(comp) || s.has(uncomp); },
+  return {std::move(name), [=](const vn100::Sample& s) { return s.has(comp) || s.has(uncomp); },
           [=](const vn100::Sample& s) { return f(s.has(comp) ? (s.*comp_member)[i] : (s.*uncomp_member)[i]); }};
 }
 
 template <std::size_t N>
-Column member(const char* name, vn100::Field field, std::array<float, N> vn100::Sample::*m, std::size_t i) {
-  return {name, [=](const vn100::Sample& s) { return s.has(field); }, [=](const vn100::Sample& s) { return f((s.*m)[i]); }};
+Column member(std::string name, vn100::Field field, std::array<float, N> vn100::Sample::*m, std::size_t i) {
+  return {std::move(name), [=](const vn100::Sample& s) { return s.has(field); }, [=](const vn100::Sample& s) { return f((s.*m)[i]); }};
 }
 
 std::vector<Column> imu_columns() {
@@ -146,22 +146,15 @@ std::vector<Column> imu_columns() {
   const char* dcm[] = {"dcm_1", "dcm_2", "dcm_3", "dcm_4", "dcm_5", "dcm_6", "dcm_7", "dcm_8", "dcm_9"};
   for (std::size_t i = 0; i < 9; ++i) c.push_back(member(dcm[i], Field::kDcm, &S::dcm, i));
   const char* ned[] = {"n", "e", "d"};
-  static std::vector<std::string> names;  // keeps the generated names alive for the columns
-  names.clear();
-  names.reserve(32);
   const auto triple = [&](const char* prefix, Field field, std::array<float, 3> S::*m) {
-    for (std::size_t i = 0; i < 3; ++i) {
-      names.push_back(std::string(prefix) + ned[i]);
-      c.push_back(member(names.back().c_str(), field, m, i));
-    }
+    for (std::size_t i = 0; i < 3; ++i) c.push_back(member(std::string(prefix) + ned[i], field, m, i));
   };
   triple("mag_ned_", Field::kMagNed, &S::mag_ned_gauss);
   triple("accel_ned_", Field::kAccelNed, &S::accel_ned_mps2);
   triple("linear_accel_ned_", Field::kLinearAccelNed, &S::linear_accel_ned_mps2);
   const char* xyz[] = {"x", "y", "z"};
   for (std::size_t i = 0; i < 3; ++i) {
-    names.push_back(std::string("linear_accel_body_") + xyz[i]);
-    c.push_back(member(names.back().c_str(), Field::kLinearAccelBody, &S::linear_accel_body_mps2, i));
+    c.push_back(member(std::string("linear_accel_body_") + xyz[i], Field::kLinearAccelBody, &S::linear_accel_body_mps2, i));
   }
   const char* ypr_u[] = {"yaw_u_deg", "pitch_u_deg", "roll_u_deg"};
   for (std::size_t i = 0; i < 3; ++i) c.push_back(member(ypr_u[i], Field::kYprUncertainty, &S::ypr_uncertainty_deg, i));
@@ -202,7 +195,7 @@ void imu_dump(const std::string& path, bool csv) {
     std::printf("file             %s\n", path.c_str());
     print_framer_counts_text(c);
     std::printf("unsizable        %" PRIu64 "\nundecodable      %" PRIu64 "\nfields          ", c.unsizable, undecodable);
-    for (const Column* col : columns) std::printf(" %s", col->name);
+    for (const Column* col : columns) std::printf(" %s", col->name.c_str());
     std::printf("\n");
     if (!samples.empty() && samples.front().has(vn100::Field::kYawPitchRoll)) {
       std::printf("first yaw/pitch/roll  %.7g %.7g %.7g deg\n", f(samples.front().ypr_deg[0]), f(samples.front().ypr_deg[1]),
@@ -210,7 +203,7 @@ void imu_dump(const std::string& path, bool csv) {
     }
     return;
   }
-  for (std::size_t i = 0; i < columns.size(); ++i) std::printf("%s%s", i == 0 ? "" : ",", columns[i]->name);
+  for (std::size_t i = 0; i < columns.size(); ++i) std::printf("%s%s", i == 0 ? "" : ",", columns[i]->name.c_str());
   std::printf("\n");
   for (const vn100::Sample& s : samples) {
     for (std::size_t i = 0; i < columns.size(); ++i) {
