@@ -1,6 +1,9 @@
 #include "trajroi/ublox/messages.hpp"
 
+#include <bit>
+
 #include "trajroi/framing/little_endian.hpp"
+#include "trajroi/ublox/config.hpp"
 #include "trajroi/ublox/utc.hpp"
 
 namespace trajroi::ublox {
@@ -215,6 +218,57 @@ Decoded<Ack> decode_ack(std::uint8_t msg_id, std::span<const std::uint8_t> p) no
   d.value.msg_class = p[0];
   d.value.msg_id = p[1];
   return d;
+}
+
+namespace {
+
+void put_u8(std::vector<std::uint8_t>& out, unsigned v) { out.push_back(static_cast<std::uint8_t>(v)); }
+void put_i8(std::vector<std::uint8_t>& out, std::int8_t v) { out.push_back(std::bit_cast<std::uint8_t>(v)); }
+void put_i32(std::vector<std::uint8_t>& out, std::int32_t v) { framing::put_le_u32(out, std::bit_cast<std::uint32_t>(v)); }
+
+}  // namespace
+
+std::vector<std::uint8_t> encode_nav_pvt(const NavPvt& m) {
+  std::vector<std::uint8_t> p;
+  p.reserve(NavPvt::kBytes);
+  framing::put_le_u32(p, m.itow_ms);
+  framing::put_le_u16(p, m.year);
+  for (const unsigned v : {unsigned{m.month}, unsigned{m.day}, unsigned{m.hour}, unsigned{m.minute}, unsigned{m.second}}) put_u8(p, v);
+  put_u8(p, (m.valid_date ? 0x01U : 0U) | (m.valid_time ? 0x02U : 0U) | (m.fully_resolved ? 0x04U : 0U));
+  framing::put_le_u32(p, m.time_accuracy_ns);
+  put_i32(p, m.nano_ns);
+  put_u8(p, m.fix_type_raw);
+  put_u8(p, (m.gnss_fix_ok ? 0x01U : 0U) | (m.diff_soln ? 0x02U : 0U) | (m.head_veh_valid ? 0x20U : 0U) |
+                (static_cast<unsigned>(m.carr_soln) << 6U));
+  put_u8(p, 0);  // flags2
+  put_u8(p, m.num_sv);
+  for (const std::int32_t v : {m.lon_e7, m.lat_e7, m.height_mm, m.hmsl_mm}) put_i32(p, v);
+  framing::put_le_u32(p, m.h_acc_mm);
+  framing::put_le_u32(p, m.v_acc_mm);
+  for (const std::int32_t v : {m.vel_n_mmps, m.vel_e_mmps, m.vel_d_mmps, m.ground_speed_mmps, m.head_mot_e5deg}) put_i32(p, v);
+  framing::put_le_u32(p, m.speed_acc_mmps);
+  framing::put_le_u32(p, m.head_acc_e5deg);
+  framing::put_le_u16(p, m.pdop_e2);
+  framing::put_le_u16(p, m.invalid_llh ? 0x01 : 0x00);  // flags3
+  framing::put_le_u32(p, 0);                             // reserved
+  put_i32(p, m.head_veh_e5deg);
+  framing::put_le_u32(p, 0);                             // magDec, magAcc
+  return encode_frame(kClassNav, kIdNavPvt, p);
+}
+
+std::vector<std::uint8_t> encode_nav_hpposllh(const NavHpposllh& m) {
+  std::vector<std::uint8_t> p;
+  p.reserve(NavHpposllh::kBytes);
+  put_u8(p, m.version);
+  put_u8(p, 0);
+  put_u8(p, 0);
+  put_u8(p, m.invalid_llh ? 0x01U : 0U);
+  framing::put_le_u32(p, m.itow_ms);
+  for (const std::int32_t v : {m.lon_e7, m.lat_e7, m.height_mm, m.hmsl_mm}) put_i32(p, v);
+  for (const std::int8_t v : {m.lon_hp_e9, m.lat_hp_e9, m.height_hp_e4m, m.hmsl_hp_e4m}) put_i8(p, v);
+  framing::put_le_u32(p, m.h_acc_e4m);
+  framing::put_le_u32(p, m.v_acc_e4m);
+  return encode_frame(kClassNav, kIdNavHpposllh, p);
 }
 
 }  // namespace trajroi::ublox

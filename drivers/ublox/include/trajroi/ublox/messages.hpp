@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <span>
 #include <string_view>
+#include <vector>
 
 namespace trajroi::ublox {
 
@@ -76,6 +77,7 @@ struct NavPvt {
   bool has_head_veh = false;                 // 92-byte form only
   std::int32_t head_veh_e5deg = 0;
 
+  bool operator==(const NavPvt&) const = default;
   [[nodiscard]] FixType fix_type() const noexcept;
   [[nodiscard]] bool utc_valid() const noexcept { return valid_date && valid_time; }
   // UTC of the epoch in ns since 1970 (the second plus nano); meaningful when utc_valid().
@@ -101,6 +103,7 @@ struct NavHpposllh {
   std::int8_t lon_hp_e9 = 0, lat_hp_e9 = 0;          // 1e-9 degree, −99 … 99
   std::int8_t height_hp_e4m = 0, hmsl_hp_e4m = 0;    // 0.1 mm, −9 … 9
   std::uint32_t h_acc_e4m = 0, v_acc_e4m = 0;        // 0.1 mm
+  bool operator==(const NavHpposllh&) const = default;
 
   // Combined in integers first, so the only rounding is the final scaling.
   [[nodiscard]] double lat_deg() const noexcept { return static_cast<double>(std::int64_t{lat_e7} * 100 + lat_hp_e9) * 1e-9; }
@@ -171,5 +174,11 @@ struct Ack {
 [[nodiscard]] Decoded<NavStatus> decode_nav_status(std::span<const std::uint8_t> payload) noexcept;
 // `msg_id` is kIdAckAck or kIdAckNak.
 [[nodiscard]] Decoded<Ack> decode_ack(std::uint8_t msg_id, std::span<const std::uint8_t> payload) noexcept;
+
+// Encoders (for the simulator and tests): the whole frame, checksum included. The 92-byte
+// NAV-PVT form is written (the vehicle heading as stored). decode(encode(m)) == m field by
+// field.
+[[nodiscard]] std::vector<std::uint8_t> encode_nav_pvt(const NavPvt& message);
+[[nodiscard]] std::vector<std::uint8_t> encode_nav_hpposllh(const NavHpposllh& message);
 
 }  // namespace trajroi::ublox

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <span>
 #include <string_view>
+#include <vector>
 
 namespace trajroi::vn100 {
 
@@ -79,5 +80,11 @@ struct Sample {
 // Decodes a whole frame (sync through CRC) whose layout parse_layout() accepts; returns false
 // (and leaves `out` partially filled) when it does not.
 [[nodiscard]] bool decode(std::span<const std::uint8_t> frame, Sample& out) noexcept;
+
+// The frame (sync through CRC) carrying `sample`'s values for the fields selected in
+// `group_fields` (index = group − 1, as encode_frame). Fields the sample does not hold are
+// written as stored (zero by default). Throws std::invalid_argument for a selection that
+// cannot be sized. decode(encode(s, f)) gives back every selected value bit for bit.
+[[nodiscard]] std::vector<std::uint8_t> encode(const Sample& sample, const std::array<std::uint16_t, 8>& group_fields);
 
 }  // namespace trajroi::vn100
