@@ -31,15 +31,6 @@ inline double json_number(std::string_view line, std::string_view key) {
   return std::strtod(tail.c_str(), nullptr);
 }
 
-inline std::string json_string(std::string_view line, std::string_view key) {
-  std::string pattern(1, '"');
-  pattern.append(key).append("\":\"");
-  const std::size_t at = line.find(pattern);
-  if (at == std::string_view::npos) return {};
-  const std::size_t begin = at + pattern.size();
-  return std::string(line.substr(begin, line.find('"', begin) - begin));
-}
-
 // The text gpsd printed for `"key":` (a number as written, or a string without its quotes).
 inline std::string json_raw(std::string_view line, std::string_view key) {
   std::string pattern(1, '"');
@@ -61,7 +52,7 @@ inline std::vector<GpsdTpv> read_gpsd_tpv(const std::string& chk_text) {
   for (std::string line; std::getline(in, line);) {
     if (line.rfind("{\"class\":\"TPV\"", 0) != 0) continue;
     GpsdTpv tpv;
-    tpv.time = json_string(line, "time");
+    tpv.time = json_raw(line, "time");
     tpv.mode = static_cast<int>(json_number(line, "mode"));
     tpv.lat = json_number(line, "lat");
     tpv.lon = json_number(line, "lon");

@@ -112,6 +112,8 @@ TEST(SerialPort, ReadsWhatTheDeviceSendsWithMonotonicStamps) {
   EXPECT_GE(stamps.front(), before);
   EXPECT_TRUE(std::is_sorted(stamps.begin(), stamps.end()));
   EXPECT_TRUE(source.is_open());
+  // libserialport cannot open a pseudo-terminal; the termios path did.
+  EXPECT_EQ(source.backend(), SerialPortSource::Backend::kTermios);
   EXPECT_EQ(source.counters().bytes, sent.size());
   EXPECT_EQ(source.counters().disconnects, 0U);
 }
@@ -172,6 +174,22 @@ TEST(SerialPort, SurvivesTheDeviceVanishingAndReopens) {
   replugged->write_all({4, 5, 6, 7});
   EXPECT_EQ(read_bytes(source, 4, 3s), (Bytes{4, 5, 6, 7}));
   EXPECT_EQ(source.counters().opens, 2U);
+}
+
+// The libserialport path needs a port libserialport can describe, such as a machine's 16550
+// UART. It opens, configures 8N1 and reads (nothing, or console noise) without failing.
+TEST(SerialPort, LibserialportOpensAPortItCanDescribe) {
+  const char* device = "/dev/ttyS0";
+  if (!std::filesystem::exists(device) || ::access(device, R_OK | W_OK) != 0) {
+    GTEST_SKIP() << device << " is absent or not accessible: no real UART to open here";
+  }
+  SerialPortSource source({device, 9600});
+  Chunk c;
+  const ReadStatus status = source.read(c, 20ms);
+  if (!source.is_open()) GTEST_SKIP() << "this machine's " << device << " cannot be opened: " << source.last_error();
+  EXPECT_EQ(source.backend(), SerialPortSource::Backend::kLibserialport);
+  EXPECT_NE(status, ReadStatus::kDisconnected);
+  EXPECT_EQ(source.counters().disconnects, 0U);
 }
 
 TEST(SerialPort, RejectsBadConfiguration) {

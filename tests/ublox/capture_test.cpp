@@ -2,6 +2,8 @@
 // the data README and gpsd's expected output (.chk) for the same logs.
 #include <gtest/gtest.h>
 
+#include "stream_feed.hpp"
+
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -15,14 +17,12 @@
 #include "test_data.hpp"
 #include "trajroi/ublox/framer.hpp"
 #include "trajroi/ublox/messages.hpp"
-#include "trajroi/ublox/utc.hpp"
+#include "trajroi/framing/utc.hpp"
 
 namespace trajroi::ublox {
 namespace {
 
-std::span<const std::uint8_t> as_bytes(const std::string& s) {
-  return {reinterpret_cast<const std::uint8_t*>(s.data()), s.size()};
-}
+using test::as_bytes;
 
 struct Frame {
   std::uint8_t msg_class;
@@ -44,11 +44,7 @@ Parsed parse(std::span<const std::uint8_t> bytes, std::size_t chunk = 0) {
   const auto sink = [&](const Message& m) {
     out.frames.push_back({m.msg_class, m.msg_id, {m.payload.begin(), m.payload.end()}});
   };
-  if (chunk == 0) chunk = bytes.size();
-  for (std::size_t at = 0; at < bytes.size(); at += chunk) {
-    framer.feed(bytes.subspan(at, std::min(chunk, bytes.size() - at)), sink);
-  }
-  framer.finish(sink);
+  test::feed_in_chunks(framer, bytes, chunk, sink);
   out.counters = framer.counters();
   out.by_type = framer.frames_by_type();
   return out;

@@ -1,11 +1,14 @@
 // The UBX framer and encoders on synthetic streams built here: every resynchronisation path.
 #include <gtest/gtest.h>
 
+#include "stream_feed.hpp"
+
 #include <cstdint>
 #include <random>
 #include <span>
 #include <vector>
 
+#include "trajroi/framing/utc.hpp"
 #include "trajroi/ublox/config.hpp"
 #include "trajroi/ublox/framer.hpp"
 #include "trajroi/ublox/messages.hpp"
@@ -34,9 +37,7 @@ Result run(std::span<const std::uint8_t> bytes, std::size_t chunk = 0, std::size
   Framer framer(max_payload);
   Result r;
   const auto sink = [&](const Message& m) { r.payloads.emplace_back(m.payload.begin(), m.payload.end()); };
-  if (chunk == 0) chunk = bytes.size() == 0 ? 1 : bytes.size();
-  for (std::size_t at = 0; at < bytes.size(); at += chunk) framer.feed(bytes.subspan(at, std::min(chunk, bytes.size() - at)), sink);
-  framer.finish(sink);
+  test::feed_in_chunks(framer, bytes, chunk, sink);
   r.counters = framer.counters();
   return r;
 }
@@ -249,6 +250,32 @@ TEST(UbxMessages, NavPvtCarrierSolutionFloatIsNotFixed) {
   p[21] = 0x01 | (3 << 6);  // reserved value 3 is not "fixed"
   EXPECT_EQ(decode_nav_pvt(p).value.carr_soln, CarrierSolution::kNone);
   EXPECT_EQ(to_string(CarrierSolution::kFixed), "fixed");
+}
+
+TEST(UbxMessages, NavPvtUtcNeedsTheFlagsAndARealDate) {
+  Bytes p(92);
+  p[4] = 0xE1;  // 2017-07-19 08:50:01, nano −100231 ns
+  p[5] = 0x07;
+  p[6] = 7;
+  p[7] = 19;
+  p[8] = 8;
+  p[9] = 50;
+  p[10] = 1;
+  p[11] = 0x03;  // validDate, validTime
+  const std::int32_t nano = -100231;
+  for (int i = 0; i < 4; ++i) p[16 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(static_cast<std::uint32_t>(nano) >> (8 * i));
+  NavPvt m = decode_nav_pvt(p).value;
+  ASSERT_TRUE(m.utc_valid());
+  EXPECT_EQ(m.utc_ns(), 1'500'454'201'000'000'000LL - 100231);  // date -u -d 2017-07-19T08:50:01Z +%s
+  EXPECT_EQ(format_utc_ms(m.utc_ns()), "2017-07-19T08:50:01.000Z");
+  p[11] = 0x01;  // time not valid
+  EXPECT_FALSE(decode_nav_pvt(p).value.utc_valid());
+  p[11] = 0x03;
+  p[6] = 13;  // flagged valid, but no 13th month
+  EXPECT_FALSE(decode_nav_pvt(p).value.utc_valid());
+  p[6] = 2;
+  p[7] = 30;  // February 30th
+  EXPECT_FALSE(decode_nav_pvt(p).value.utc_valid());
 }
 
 TEST(UbxNames, KnownAndUnknownMessages) {

@@ -2,6 +2,8 @@
 // frame counts from the data README and every decoded value against the author's CSV.
 #include <gtest/gtest.h>
 
+#include "stream_feed.hpp"
+
 #include <cmath>
 #include <cstdint>
 #include <sstream>
@@ -17,9 +19,7 @@
 namespace trajroi::vn100 {
 namespace {
 
-std::span<const std::uint8_t> as_bytes(const std::string& s) {
-  return {reinterpret_cast<const std::uint8_t*>(s.data()), s.size()};
-}
+using test::as_bytes;
 
 struct Parsed {
   std::vector<Sample> samples;
@@ -36,9 +36,7 @@ Parsed parse(std::span<const std::uint8_t> bytes, std::size_t chunk = 0) {
     out.samples.push_back(s);
     out.frames.emplace_back(frame.begin(), frame.end());
   };
-  if (chunk == 0) chunk = bytes.size();
-  for (std::size_t at = 0; at < bytes.size(); at += chunk) framer.feed(bytes.subspan(at, std::min(chunk, bytes.size() - at)), sink);
-  framer.finish(sink);
+  test::feed_in_chunks(framer, bytes, chunk, sink);
   out.counters = framer.counters();
   return out;
 }

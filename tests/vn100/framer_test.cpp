@@ -1,6 +1,8 @@
 // The VN-100 framer, decoder and commands on frames built here.
 #include <gtest/gtest.h>
 
+#include "stream_feed.hpp"
+
 #include <bit>
 #include <cstdint>
 #include <random>
@@ -50,9 +52,7 @@ Result run(std::span<const std::uint8_t> bytes, std::size_t chunk = 0) {
     EXPECT_TRUE(decode(frame, s));
     r.samples.push_back(s);
   };
-  if (chunk == 0) chunk = bytes.empty() ? 1 : bytes.size();
-  for (std::size_t at = 0; at < bytes.size(); at += chunk) framer.feed(bytes.subspan(at, std::min(chunk, bytes.size() - at)), sink);
-  framer.finish(sink);
+  test::feed_in_chunks(framer, bytes, chunk, sink);
   r.counters = framer.counters();
   return r;
 }

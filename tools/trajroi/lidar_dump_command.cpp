@@ -3,7 +3,6 @@
 // point as CSV.
 #include <algorithm>
 #include <cerrno>
-#include <chrono>
 #include <cinttypes>
 #include <cstdio>
 #include <cstring>
@@ -17,6 +16,7 @@
 
 #include "commands.hpp"
 #include "file_io.hpp"
+#include "trajroi/framing/utc.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
 #include "trajroi/vlp16/stream_decoder.hpp"
 
@@ -72,19 +72,6 @@ struct NullSink final : FrameSink {
   void on_frame(const Frame&) override {}
 };
 
-std::string utc_text(std::int64_t utc_ns) {
-  namespace c = std::chrono;
-  const c::sys_time<c::nanoseconds> t{c::nanoseconds{utc_ns}};
-  const auto day = c::floor<c::days>(t);
-  const c::year_month_day ymd{day};
-  const c::hh_mm_ss hms{c::floor<c::milliseconds>(t - day)};
-  char text[40];
-  std::snprintf(text, sizeof text, "%04d-%02u-%02uT%02ld:%02ld:%02ld.%03ldZ", int{ymd.year()}, unsigned{ymd.month()},
-                unsigned{ymd.day()}, static_cast<long>(hms.hours().count()), static_cast<long>(hms.minutes().count()),
-                static_cast<long>(hms.seconds().count()), static_cast<long>(hms.subseconds().count()));
-  return text;
-}
-
 std::string json_string(const std::string& s) {
   std::string out = "\"";
   for (const char ch : s) {
@@ -106,7 +93,7 @@ std::string rmc_json(const std::optional<PositionPacket>& p) {
   if (!p) return "null";
   char text[200];
   std::snprintf(text, sizeof text, "{\"utc\": \"%s\", \"valid\": %s, \"lat\": %.9f, \"lon\": %.9f}",
-                utc_text(p->rmc.utc_ns).c_str(), p->rmc.valid ? "true" : "false", p->rmc.latitude_deg,
+                format_utc_ms(p->rmc.utc_ns).c_str(), p->rmc.valid ? "true" : "false", p->rmc.latitude_deg,
                 p->rmc.longitude_deg);
   return text;
 }

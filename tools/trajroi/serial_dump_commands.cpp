@@ -4,7 +4,6 @@
 #include <cinttypes>
 #include <cstdio>
 #include <functional>
-#include <map>
 #include <string>
 #include <vector>
 
@@ -12,7 +11,7 @@
 #include "trajroi/serial/byte_log.hpp"
 #include "trajroi/ublox/framer.hpp"
 #include "trajroi/ublox/messages.hpp"
-#include "trajroi/ublox/utc.hpp"
+#include "trajroi/framing/utc.hpp"
 #include "trajroi/vn100/decoder.hpp"
 #include "trajroi/vn100/framer.hpp"
 
@@ -45,14 +44,14 @@ void print_framer_counts_text(const framing::FramerCounters& c) {
 void gnss_dump(const std::string& path, bool json) {
   ublox::Framer framer;
   std::vector<ublox::NavPvt> fixes;
-  std::map<std::string, std::uint64_t> malformed;  // by message name: payload errors
+  std::uint64_t malformed_nav_pvt = 0;  // framed, but a payload NAV-PVT cannot be
   const auto on_message = [&](const ublox::Message& m) {
     if (m.msg_class != ublox::kClassNav || m.msg_id != ublox::kIdNavPvt) return;
     const auto d = ublox::decode_nav_pvt(m.payload);
     if (d.ok()) {
       fixes.push_back(d.value);
     } else {
-      ++malformed["NAV-PVT"];
+      ++malformed_nav_pvt;
     }
   };
   for_each_chunk(path, [&](std::span<const std::uint8_t> bytes) { framer.feed(bytes, on_message); });
@@ -65,11 +64,11 @@ void gnss_dump(const std::string& path, bool json) {
     for (const auto& [key, n] : framer.frames_by_type()) {
       std::printf("  %-14s %" PRIu64 "\n", ublox::message_name(static_cast<std::uint8_t>(key >> 8), static_cast<std::uint8_t>(key & 0xFF)).c_str(), n);
     }
-    for (const auto& [name, n] : malformed) std::printf("malformed %s: %" PRIu64 "\n", name.c_str(), n);
+    if (malformed_nav_pvt != 0) std::printf("malformed NAV-PVT %" PRIu64 "\n", malformed_nav_pvt);
     std::printf("NAV-PVT epochs   %zu\n", fixes.size());
     for (const ublox::NavPvt& f : fixes) {
       std::printf("  %s fix %u %-5s sv %2u  %.7f %.7f  h %.3f m  msl %.3f m  hacc %.3f m\n",
-                  f.utc_valid() ? ublox::format_utc_ms(f.utc_ns()).c_str() : "(no UTC)                ",
+                  f.utc_valid() ? format_utc_ms(f.utc_ns()).c_str() : "(no UTC)                ",
                   unsigned{f.fix_type_raw}, std::string(to_string(f.carr_soln)).c_str(), unsigned{f.num_sv}, f.lat_deg(),
                   f.lon_deg(), f.height_m(), f.hmsl_m(), f.h_acc_m());
     }
@@ -85,13 +84,13 @@ void gnss_dump(const std::string& path, bool json) {
     first = false;
   }
   std::printf("},\n  \"frames_total\": %" PRIu64 ",\n  \"malformed_nav_pvt\": %" PRIu64 ",\n  \"fixes\": [", c.frames,
-              malformed.count("NAV-PVT") != 0 ? malformed["NAV-PVT"] : 0);
+              malformed_nav_pvt);
   for (std::size_t i = 0; i < fixes.size(); ++i) {
     const ublox::NavPvt& f = fixes[i];
     std::printf("%s\n    {\"utc\": %s%s%s, \"itow_ms\": %" PRIu32 ", \"fix_type\": %u, \"gnss_fix_ok\": %s, \"carr_soln\": \"%s\", "
                 "\"num_sv\": %u, \"lat\": %.9f, \"lon\": %.9f, \"height_m\": %.3f, \"hmsl_m\": %.3f, \"h_acc_m\": %.3f, "
                 "\"v_acc_m\": %.3f, \"ground_speed_mps\": %.3f, \"head_mot_deg\": %.5f}",
-                i == 0 ? "" : ",", f.utc_valid() ? "\"" : "", f.utc_valid() ? ublox::format_utc_ms(f.utc_ns()).c_str() : "null",
+                i == 0 ? "" : ",", f.utc_valid() ? "\"" : "", f.utc_valid() ? format_utc_ms(f.utc_ns()).c_str() : "null",
                 f.utc_valid() ? "\"" : "", f.itow_ms, unsigned{f.fix_type_raw}, f.gnss_fix_ok ? "true" : "false",
                 std::string(to_string(f.carr_soln)).c_str(), unsigned{f.num_sv}, f.lat_deg(), f.lon_deg(), f.height_m(),
                 f.hmsl_m(), f.h_acc_m(), f.v_acc_m(), f.ground_speed_mps(), f.head_mot_deg());

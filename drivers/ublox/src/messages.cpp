@@ -4,7 +4,7 @@
 
 #include "trajroi/framing/little_endian.hpp"
 #include "trajroi/ublox/config.hpp"
-#include "trajroi/ublox/utc.hpp"
+#include "trajroi/framing/utc.hpp"
 
 namespace trajroi::ublox {
 
@@ -56,10 +56,16 @@ FixType NavPvt::fix_type() const noexcept {
   return fix_type_raw <= 5 ? static_cast<FixType>(fix_type_raw) : FixType::kNoFix;
 }
 
+bool NavPvt::utc_valid() const noexcept {
+  return valid_date && valid_time && date().ok() && hour < 24 && minute < 60 && second <= 60;
+}
+
+std::chrono::year_month_day NavPvt::date() const noexcept {
+  return std::chrono::year{year} / std::chrono::month{month} / std::chrono::day{day};
+}
+
 std::int64_t NavPvt::utc_ns() const noexcept {
-  const std::int64_t days = days_from_civil(year, month, day);
-  const std::int64_t seconds = days * 86'400 + hour * 3'600 + minute * 60 + second;
-  return seconds * 1'000'000'000 + nano_ns;
+  return utc_ns_from_civil(date(), hour * 3'600 + minute * 60 + second) + nano_ns;
 }
 
 Decoded<NavPvt> decode_nav_pvt(std::span<const std::uint8_t> p) noexcept {

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "trajroi/framing/utc.hpp"
 #include "trajroi/vlp16/packet.hpp"
 
 namespace trajroi::vlp16 {
@@ -121,9 +122,7 @@ NmeaError parse_rmc(std::string_view sentence, Rmc& out) noexcept {
       !parse_angle(field[5], 3, field[6], 'E', 'W', 180.0, rmc.longitude_deg)) {
     return NmeaError::kMalformed;
   }
-  const std::int64_t days = std::chrono::sys_days{ymd}.time_since_epoch().count();
-  const std::int64_t second_of_day = hh * 3600 + mm * 60;
-  rmc.utc_ns = (days * 86400 + second_of_day) * 1'000'000'000 + std::llround(ss * 1e9);
+  rmc.utc_ns = utc_ns_from_civil(ymd, hh * 3600 + mm * 60) + std::llround(ss * 1e9);
   rmc.valid = field[2] == "A";
   out = rmc;
   return NmeaError::kNone;

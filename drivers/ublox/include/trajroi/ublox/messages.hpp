@@ -5,6 +5,7 @@
 // receiver's own integer units (named so) plus SI accessors, or the reason it could not.
 // Payloads are read field by field, little-endian; never cast to a struct.
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <span>
 #include <string_view>
@@ -79,7 +80,9 @@ struct NavPvt {
 
   bool operator==(const NavPvt&) const = default;
   [[nodiscard]] FixType fix_type() const noexcept;
-  [[nodiscard]] bool utc_valid() const noexcept { return valid_date && valid_time; }
+  // The receiver flags date and time valid AND they form a real date and time of day.
+  [[nodiscard]] bool utc_valid() const noexcept;
+  [[nodiscard]] std::chrono::year_month_day date() const noexcept;
   // UTC of the epoch in ns since 1970 (the second plus nano); meaningful when utc_valid().
   [[nodiscard]] std::int64_t utc_ns() const noexcept;
   [[nodiscard]] double lat_deg() const noexcept { return lat_e7 * 1e-7; }
