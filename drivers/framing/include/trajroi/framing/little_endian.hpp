@@ -49,4 +49,14 @@ inline void put_le_u64(std::vector<std::uint8_t>& out, std::uint64_t v) {
   put_le_u32(out, static_cast<std::uint32_t>(v >> 32));
 }
 
+// In-place writers at an offset; the caller checked the span is long enough.
+inline void store_le_u16(std::span<std::uint8_t> b, std::size_t at, std::uint16_t v) noexcept {
+  b[at] = static_cast<std::uint8_t>(v);
+  b[at + 1] = static_cast<std::uint8_t>(v >> 8);
+}
+inline void store_le_u32(std::span<std::uint8_t> b, std::size_t at, std::uint32_t v) noexcept {
+  store_le_u16(b, at, static_cast<std::uint16_t>(v));
+  store_le_u16(b, at + 2, static_cast<std::uint16_t>(v >> 16));
+}
+
 }  // namespace trajroi::framing
