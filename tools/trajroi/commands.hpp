@@ -9,5 +9,6 @@ void add_eval_commands(CLI::App& app);
 void add_filter_command(CLI::App& app);
 void add_lidar_dump_command(CLI::App& app);
 void add_serial_dump_commands(CLI::App& app);  // gnss-dump, imu-dump
+void add_sim_command(CLI::App& app);
 
 }  // namespace trajroi::cli
