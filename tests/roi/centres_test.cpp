@@ -69,5 +69,23 @@ TEST(Centres, SpacingFromRatio) {
   EXPECT_DOUBLE_EQ(spacing_from_ratio(0.25, 3.0), 0.75);
 }
 
+// The factory keyframe 2 set-up: s0 = 26.07, a 42 m look-ahead and 21 m spacing (75 % of a
+// 28 m circle). 26.07 + 42 − 26.07 is 41.99999999999999 in double, which must still give the
+// three centres s0, s0 + 21 and s0 + 42.
+TEST(Centres, LookAheadOfWholeSpacingsKeepsItsLastCentre) {
+  const Trajectory t({{0.0, 0.0}, {110.0, 0.0}});
+  ASSERT_LT((26.07 + 42.0) - 26.07, 42.0);  // the rounding this test is about
+  std::vector<Centre> out;
+  place_centres(t, 26.07, 42.0, 21.0, out);
+  ASSERT_EQ(out.size(), 3u);
+  EXPECT_DOUBLE_EQ(out.back().s_m, 26.07 + 42.0);
+  place_centres(t, 26.07, 42.0, 3.0, out);
+  EXPECT_EQ(out.size(), 15u);
+  // Clipped by the end: no centre past it.
+  place_centres(t, 100.0, 42.0, 5.0, out);
+  ASSERT_EQ(out.size(), 3u);
+  EXPECT_DOUBLE_EQ(out.back().s_m, 110.0);
+}
+
 }  // namespace
 }  // namespace trajroi::roi

@@ -10,5 +10,8 @@ void add_filter_command(CLI::App& app);
 void add_lidar_dump_command(CLI::App& app);
 void add_serial_dump_commands(CLI::App& app);  // gnss-dump, imu-dump
 void add_sim_command(CLI::App& app);
+void add_render_command(CLI::App& app);
+// keyframes, sequential, accumulated under `eval`.
+void add_scenario_eval_commands(CLI::App& eval_cmd);
 
 }  // namespace trajroi::cli

@@ -46,31 +46,13 @@ void write_row_svg(const std::filesystem::path& dir, const eval::ArtificialScene
                 static_cast<unsigned long long>(row.confusion.tn));
   eval::SvgCanvas canvas = straight ? eval::SvgCanvas(-4.0, -8.0, 87.0, 8.0, 12.0, title)
                                     : eval::SvgCanvas(-4.0, -8.0, 58.0, 57.0, 12.0, title);
-  std::vector<std::uint8_t> kept_mask(scene.points.size(), 0);
-  for (const std::uint32_t i : row.kept) kept_mask[i] = 1;
-  for (std::size_t i = 0; i < scene.points.size(); ++i) {
-    const bool truth = scene.truth[i] != 0;
-    const bool kept = kept_mask[i] != 0;
-    const std::string_view colour = kept ? (truth ? eval::kColourTp : eval::kColourFp)
-                                         : (truth ? eval::kColourFn : eval::kColourTn);
-    canvas.dot(scene.points[i].x, scene.points[i].y, colour, 1.6);
-  }
-  for (const roi::Centre& c : row.centres) {
-    if (row.shape == eval::RoiShape::kCircular) {
-      canvas.circle(c.position.x(), c.position.y(), eval::kCircleDiameter_m / 2.0, eval::kColourRoi);
-    } else {
-      const Eigen::Vector2d u = eval::kRectHeight_m / 2.0 * Eigen::Vector2d(std::cos(c.theta_rad), std::sin(c.theta_rad));
-      const Eigen::Vector2d v = eval::kRectWidth_m / 2.0 * Eigen::Vector2d(-u.y(), u.x()).normalized();
-      const Eigen::Vector2d corners[4] = {c.position - u - v, c.position - u + v,
-                                          c.position + u + v, c.position + u - v};
-      canvas.polygon(corners, eval::kColourRoi);
-    }
-  }
+  std::vector<Eigen::Vector2d> xy;
+  xy.reserve(scene.points.size());
+  for (const roi::PointXYZd& p : scene.points) xy.emplace_back(p.x, p.y);
+  draw_classified(canvas, xy, row.kept, scene.truth, 1.6);
+  const bool circles = row.shape == eval::RoiShape::kCircular;
+  draw_chain(canvas, row.centres, circles, circles ? eval::kCircleDiameter_m : eval::kRectHeight_m, eval::kRectWidth_m);
   canvas.polyline(scene.trajectory.waypoints(), eval::kColourTrajectory);
-  canvas.legend(eval::kColourTp, "TP: kept, in the ground-truth corridor");
-  canvas.legend(eval::kColourFp, "FP: kept, outside it");
-  canvas.legend(eval::kColourFn, "FN: missed");
-  canvas.legend(eval::kColourTn, "TN: dropped, outside it");
   char name[96];
   std::snprintf(name, sizeof name, "%s_%s_%03d.svg", std::string(to_string(row.data)).c_str(),
                 std::string(to_string(row.shape)).c_str(), row.ratio_pct);
@@ -167,6 +149,7 @@ void add_eval_commands(CLI::App& app) {
   artificial->add_option("--svg", options->svg_dir,
                          "Write one top-down SVG per row (TP/FP/FN/TN, ROIs, trajectory) here");
   artificial->callback([options] { run_artificial(*options); });
+  add_scenario_eval_commands(*eval_cmd);
 }
 
 }  // namespace trajroi::cli

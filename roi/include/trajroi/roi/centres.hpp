@@ -21,7 +21,8 @@ inline constexpr std::size_t kMaxCentres = 1'000'000;
 
 // Places c_k = P(s0 + k·d), θ_k = heading(s0 + k·d) for k = 0 … ⌊(s1 − s0)/d⌋, where s0 is
 // clamped to [0, length] and s1 = min(s0 + look_ahead, length) (look_ahead may be +∞: to the
-// end). `out` is cleared and refilled; its capacity is reused, so a warm caller allocates
+// end); a look-ahead of exactly n spacings gives n + 1 centres whatever the rounding of
+// s0 + look_ahead. `out` is cleared and refilled; its capacity is reused, so a warm caller allocates
 // nothing. Throws std::invalid_argument when spacing_m is not finite and positive, when
 // look_ahead_m is negative or NaN, or when the chain would exceed kMaxCentres.
 void place_centres(const Trajectory& trajectory, double s0_m, double look_ahead_m,

@@ -1,0 +1,92 @@
+#pragma once
+
+// From the GNSS and IMU byte streams to the pose buffer: frames UBX and VN-100 bytes, decodes
+// NAV-HPPOSLLH / NAV-PVT and the VN-100 attitude, places them in the global frame and stamps
+// them in the host clock. Pure: bytes and receive times in, samples into a PoseBuffer out.
+//
+// Time. A sample is stamped with its sensor time (UBX iTOW, VN-100 TimeStartup) mapped onto
+// the host clock by ClockMap — host = sensor + min(receive − sensor) − delay — so serial
+// jitter does not reach the pose; `delay` is the known part of the transport (epoch to the
+// message's receipt) that the minimum cannot see.
+//
+// Position. NAV-PVT closes an epoch: its position comes from the NAV-HPPOSLLH of the same
+// iTOW when one came before it (0.1 mm instead of 1 cm), else from NAV-PVT itself; its
+// quality (fix type, gnssFixOK, carrier solution, hAcc) goes with it to the pose gate. An
+// epoch flagged invalidLlh keeps the last position with its own (failing) quality, so the
+// gate reports a lost fix rather than a gap.
+#include <cstdint>
+#include <optional>
+#include <span>
+
+#include "trajroi/pose/attitude.hpp"
+#include "trajroi/pose/geodetic.hpp"
+#include "trajroi/pose/pose_buffer.hpp"
+#include "trajroi/ublox/framer.hpp"
+#include "trajroi/ublox/messages.hpp"
+#include "trajroi/vn100/decoder.hpp"
+#include "trajroi/vn100/framer.hpp"
+
+namespace trajroi::pose_input {
+
+// host ≈ sensor + offset, offset = the least (receive − sensor) seen since the last reset.
+// A sensor time that goes backwards, or a receive time further than `reset_threshold_ns`
+// from the mapped time, resets the map (counted).
+class ClockMap {
+ public:
+  explicit ClockMap(std::int64_t reset_threshold_ns = 1'000'000'000) noexcept : threshold_ns_(reset_threshold_ns) {}
+  [[nodiscard]] std::int64_t map(std::int64_t sensor_ns, std::int64_t receive_ns) noexcept;
+  [[nodiscard]] std::uint64_t resets() const noexcept { return resets_; }
+
+ private:
+  std::int64_t threshold_ns_;
+  std::optional<std::int64_t> offset_ns_;
+  std::int64_t last_sensor_ns_ = 0;
+  std::uint64_t resets_ = 0;
+};
+
+struct PoseInputConfig {
+  pose::ImuMounting imu;
+  std::int64_t gnss_delay_ns = 0;  // epoch → receipt of its NAV-PVT
+  std::int64_t imu_delay_ns = 0;   // sample → receipt of its frame
+};
+
+struct PoseInputCounters {
+  std::uint64_t fixes = 0;             // NAV-PVT epochs given to the buffer
+  std::uint64_t high_precision = 0;    // … of which placed with NAV-HPPOSLLH
+  std::uint64_t invalid_position = 0;  // epochs flagged invalidLlh
+  std::uint64_t malformed = 0;         // framed UBX/VN-100 that did not decode
+  std::uint64_t attitudes = 0;
+  std::uint64_t imu_without_attitude = 0;  // frames lacking TimeStartup or YawPitchRoll
+  std::uint64_t refused = 0;           // samples the buffer refused (order, non-finite)
+};
+
+class PoseInput {
+ public:
+  PoseInput(pose::GlobalFrame frame, const PoseInputConfig& config, pose::PoseBuffer& buffer);
+
+  void gnss_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns);
+  void imu_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns);
+  // Already framed and decoded (for callers that frame themselves).
+  void on_ubx(const ublox::Message& message, std::int64_t receive_ns);
+  void on_vn100(const vn100::Sample& sample, std::int64_t receive_ns);
+
+  [[nodiscard]] const PoseInputCounters& counters() const noexcept { return counters_; }
+  [[nodiscard]] const framing::FramerCounters& gnss_framing() const noexcept { return ubx_.counters(); }
+  [[nodiscard]] const framing::FramerCounters& imu_framing() const noexcept { return vn_.counters(); }
+  [[nodiscard]] const ClockMap& gnss_clock() const noexcept { return gnss_clock_; }
+  [[nodiscard]] const ClockMap& imu_clock() const noexcept { return imu_clock_; }
+
+ private:
+  pose::GlobalFrame frame_;
+  PoseInputConfig config_;
+  pose::PoseBuffer& buffer_;
+  ublox::Framer ubx_;
+  vn100::Framer vn_;
+  ClockMap gnss_clock_;
+  ClockMap imu_clock_;
+  std::optional<ublox::NavHpposllh> hp_;
+  std::optional<pose::Geodetic> last_position_;
+  PoseInputCounters counters_;
+};
+
+}  // namespace trajroi::pose_input

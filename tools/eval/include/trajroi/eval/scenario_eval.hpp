@@ -1,0 +1,168 @@
+#pragma once
+
+// The paper's evaluations on a simulated run (Tables 9, 11, 18, 19 and 20), through the real
+// pipeline: lidar.pcap decoded by the VLP-16 driver, the pose estimated from the decoded GNSS
+// and IMU recordings by the pose library, points placed in the global frame and filtered by
+// the fast ROI filters. The simulator's truth (the true pose at every firing) says where each
+// measured point really is, so pose errors show in the figures.
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "trajroi/eval/artificial.hpp"
+#include "trajroi/eval/timing.hpp"
+#include "trajroi/pose/pose_buffer.hpp"
+#include "trajroi/pose_input/pose_input.hpp"
+#include "trajroi/roi/centres.hpp"
+#include "trajroi/roi/metrics.hpp"
+#include "trajroi/roi/point.hpp"
+#include "trajroi/roi/trajectory.hpp"
+#include "trajroi/sim/run_folder.hpp"
+#include "trajroi/sim/scenario.hpp"
+#include "trajroi/vlp16/stream_decoder.hpp"
+
+namespace trajroi::eval {
+
+// A run folder opened for evaluation. Throws std::runtime_error (or config::ConfigError for
+// its scenario.yaml) naming what is wrong when `dir` is not a complete run.
+class ScenarioRun {
+ public:
+  explicit ScenarioRun(const std::filesystem::path& dir);
+  ~ScenarioRun();
+
+  [[nodiscard]] const std::filesystem::path& dir() const noexcept { return dir_; }
+  [[nodiscard]] const sim::Scenario& scenario() const noexcept { return scenario_; }
+  [[nodiscard]] const roi::Trajectory& trajectory() const noexcept { return *trajectory_; }
+  [[nodiscard]] const pose::PoseBuffer& poses() const noexcept { return *poses_; }
+  [[nodiscard]] const pose_input::PoseInputCounters& pose_counters() const noexcept { return pose_counters_; }
+  [[nodiscard]] const sim::TruthPoses& truth() const noexcept { return *truth_; }
+  [[nodiscard]] const std::vector<std::uint8_t>& labels() const noexcept { return labels_; }
+  [[nodiscard]] const Eigen::Isometry3d& robot_from_lidar() const noexcept { return robot_from_lidar_; }
+
+  // Decodes lidar.pcap and calls on_frame(frame, index of its first point in the whole run,
+  // wall time spent decoding the packets since the previous frame in ms) for every frame,
+  // partial ones included, in order. Returns the decoder's counters.
+  using FrameCallback = std::function<void(const vlp16::Frame&, std::uint64_t first_point, double decode_ms)>;
+  vlp16::StreamCounters for_each_frame(const FrameCallback& on_frame) const;
+
+ private:
+  std::filesystem::path dir_;
+  sim::Scenario scenario_;
+  std::unique_ptr<roi::Trajectory> trajectory_;
+  std::unique_ptr<pose::PoseBuffer> poses_;
+  pose_input::PoseInputCounters pose_counters_;
+  std::unique_ptr<sim::TruthPoses> truth_;
+  std::vector<std::uint8_t> labels_;
+  Eigen::Isometry3d robot_from_lidar_ = Eigen::Isometry3d::Identity();
+};
+
+// How a frame's points get their pose: one per firing sequence (55.3 µs, motion-compensated)
+// or one for the whole frame, at its middle (the paper's way).
+enum class PoseMode { kPerFiring, kPerFrame };
+
+// Places the frame's points in the global frame with the estimated pose. False when a pose
+// it needs is not valid (`status` says why; `out` is then incomplete).
+bool place_frame(const vlp16::Frame& frame, const pose::PoseBuffer& poses, const Eigen::Isometry3d& robot_from_lidar,
+                 PoseMode mode, std::vector<roi::PointXYZI>& out, pose::PoseStatus& status);
+
+// Where the frame's measured points really are: each placed with the true pose at its time.
+void place_frame_truth(const vlp16::Frame& frame, const sim::TruthPoses& truth,
+                       const Eigen::Isometry3d& robot_from_lidar, std::vector<roi::PointXYZd>& out);
+
+// ---- Tables 9 and 11: keyframes --------------------------------------------------------------
+
+struct KeyframeCase {
+  sim::Keyframe keyframe;
+  std::int64_t time_ns = 0;         // when the true robot is nearest the keyframe pose
+  std::uint64_t frame_index = 0;
+  std::vector<roi::PointXYZI> points;   // global frame, estimated pose
+  std::vector<roi::PointXYZd> truth;    // global frame, true pose
+  Eigen::Isometry3d robot_pose = Eigen::Isometry3d::Identity();  // estimated, at time_ns
+  double s0_m = 0.0;                // the robot's projection on the trajectory
+  vlp16::Frame frame;               // as decoded (sensor frame)
+};
+
+// Finds each keyframe's frame and prepares it. Throws std::runtime_error when a keyframe is
+// not near the run's path or its pose is not valid.
+[[nodiscard]] std::vector<KeyframeCase> keyframe_cases(const ScenarioRun& run, PoseMode mode);
+
+struct KeyframeRow {
+  std::string keyframe;
+  RoiShape shape;
+  int ratio_pct;
+  std::vector<roi::Centre> centres;
+  roi::Confusion confusion;
+  TimingStats time;
+  roi::IndexVector kept;
+  std::vector<std::uint8_t> truth;  // per point: in the ground-truth corridor matched to this chain
+};
+
+// One row: the chain from the robot's projection over the look-ahead, spacing ratio × size;
+// ground truth: the corridor of the ROI's width from the chain's first to its last centre,
+// with round ends (circles) or extended by a/2 with square ends (rectangles), so only the
+// middle of the chains is compared (the paper's matching of the ends). Timed `reps` times:
+// transform with the pose, centres, ROI set, grid and filter.
+[[nodiscard]] KeyframeRow run_keyframe_row(const ScenarioRun& run, const KeyframeCase& c, RoiShape shape,
+                                           int ratio_pct, int reps, PoseMode mode);
+
+// ---- Table 18: sequential frames ------------------------------------------------------------
+
+struct FrameTiming {
+  std::uint64_t frame_index;
+  double start_s;           // after the first frame
+  double cycle_ms;          // since the previous frame's start (0 for the first)
+  std::size_t points;
+  double circular_ms;
+  double rectangular_ms;
+};
+
+struct SequentialReport {
+  std::size_t frames = 0;            // complete frames with a valid pose
+  std::size_t skipped_no_pose = 0;
+  std::size_t skipped_partial = 0;
+  double avg_points = 0.0;
+  TimingStats cycle, circular, rectangular;
+  std::vector<FrameTiming> per_frame;
+};
+
+// Every complete frame through decode → place → ROI (both shapes, 25 %), the decode of each
+// frame's packets included in both shapes' times.
+[[nodiscard]] SequentialReport run_sequential(const ScenarioRun& run, PoseMode mode, int ratio_pct = 25);
+
+// ---- Table 19: accumulated frames -----------------------------------------------------------
+
+inline constexpr std::array<int, 7> kAccumulations{1, 5, 10, 25, 50, 75, 100};
+
+struct AccumulatedRow {
+  RoiShape shape;
+  int frames_per_cloud;
+  std::size_t clouds;
+  double avg_points;
+  TimingStats time;
+};
+
+struct LinearFit {
+  double slope_ms_per_mpoint = 0.0;
+  double intercept_ms = 0.0;
+  double r2 = 0.0;
+};
+
+struct AccumulatedReport {
+  std::vector<AccumulatedRow> rows;
+  LinearFit circular_fit, rectangular_fit;
+  // Every cloud's (points, ms), for the plot.
+  std::vector<std::pair<double, double>> circular_samples, rectangular_samples;
+};
+
+// Consecutive complete frames placed in the global frame and joined N at a time; each cloud
+// filtered once per shape (centres from the robot's projection at its last frame; time:
+// centres, ROI set, grid and filter) at 25 %.
+[[nodiscard]] AccumulatedReport run_accumulated(const ScenarioRun& run, PoseMode mode, int ratio_pct = 25);
+
+[[nodiscard]] LinearFit fit_line(const std::vector<std::pair<double, double>>& samples_points_ms);
+
+}  // namespace trajroi::eval
