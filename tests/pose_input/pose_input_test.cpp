@@ -1,0 +1,112 @@
+// GNSS and IMU messages (built with the drivers' encoders) into the pose buffer: clock
+// mapping, high-precision positions, invalid fixes and the attitude's frame.
+#include "trajroi/pose_input/pose_input.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "trajroi/ublox/config.hpp"
+
+namespace trajroi::pose_input {
+namespace {
+
+TEST(ClockMap, TakesTheLeastDelayAndResetsOnAJump) {
+  ClockMap clock(1'000'000'000);
+  EXPECT_EQ(clock.map(1'000, 5'000), 5'000);      // offset 4000
+  EXPECT_EQ(clock.map(2'000, 6'500), 6'000);      // 4500 > 4000: jitter ignored
+  EXPECT_EQ(clock.map(3'000, 6'800), 6'800);      // offset 3800: the new floor
+  EXPECT_EQ(clock.map(4'000, 8'000), 7'800);
+  EXPECT_EQ(clock.resets(), 0u);
+  EXPECT_EQ(clock.map(1'000, 9'000), 9'000);      // sensor time went backwards
+  EXPECT_EQ(clock.resets(), 1u);
+  EXPECT_EQ(clock.map(2'000, 3'000'000'000), 3'000'000'000);  // host jumped by 3 s
+  EXPECT_EQ(clock.resets(), 2u);
+}
+
+class PoseInputTest : public ::testing::Test {
+ protected:
+  PoseInputTest()
+      : origin_{36.0, 127.0, 50.0},
+        buffer_(pose::PoseGate{}, Eigen::Vector3d::Zero(), 64),
+        input_(pose::GlobalFrame::local_cartesian(origin_), config(), buffer_) {}
+  static PoseInputConfig config() {
+    PoseInputConfig c;
+    c.gnss_delay_ns = 30'000'000;
+    return c;
+  }
+  static ublox::NavPvt pvt(std::uint32_t itow_ms, double lat, double lon) {
+    ublox::NavPvt m;
+    m.itow_ms = itow_ms;
+    m.fix_type_raw = 3;
+    m.gnss_fix_ok = true;
+    m.carr_soln = ublox::CarrierSolution::kFixed;
+    m.lat_e7 = static_cast<std::int32_t>(std::llround(lat * 1e7));
+    m.lon_e7 = static_cast<std::int32_t>(std::llround(lon * 1e7));
+    m.height_mm = 50'000;
+    m.h_acc_mm = 14;
+    return m;
+  }
+  pose::Geodetic origin_;
+  pose::PoseBuffer buffer_;
+  PoseInput input_;
+};
+
+TEST_F(PoseInputTest, HighPrecisionPositionOfTheSameEpochIsUsed) {
+  // 1 m north of the origin in NAV-HPPOSLLH; NAV-PVT rounds it to 1e-7° (≈ 1.1 cm).
+  const pose::GlobalFrame frame = pose::GlobalFrame::local_cartesian(origin_);
+  const pose::Geodetic north = frame.to_geodetic({0.3, 1.0, 0.0});
+  ublox::NavHpposllh hp;
+  hp.itow_ms = 1000;
+  const std::int64_t lat_e9 = std::llround(north.lat_deg * 1e9), lon_e9 = std::llround(north.lon_deg * 1e9);
+  hp.lat_e7 = static_cast<std::int32_t>(lat_e9 / 100);
+  hp.lat_hp_e9 = static_cast<std::int8_t>(lat_e9 % 100);
+  hp.lon_e7 = static_cast<std::int32_t>(lon_e9 / 100);
+  hp.lon_hp_e9 = static_cast<std::int8_t>(lon_e9 % 100);
+  const std::int64_t h_e4 = std::llround(north.height_m * 1e4);
+  hp.height_mm = static_cast<std::int32_t>(h_e4 / 10);
+  hp.height_hp_e4m = static_cast<std::int8_t>(h_e4 % 10);
+  hp.h_acc_e4m = 100;
+  input_.gnss_bytes(ublox::encode_nav_hpposllh(hp), 5'000'000'000);
+  input_.gnss_bytes(ublox::encode_nav_pvt(pvt(1000, north.lat_deg, north.lon_deg)), 5'040'000'000);
+  EXPECT_EQ(input_.counters().fixes, 1u);
+  EXPECT_EQ(input_.counters().high_precision, 1u);
+  // The epoch: received 40 ms after... mapped back by the configured 30 ms delay.
+  vn100::Sample s;
+  s.set(vn100::Field::kTimeStartup);
+  s.set(vn100::Field::kYawPitchRoll);
+  s.ypr_deg = {0.0f, 0.0f, 0.0f};  // facing north
+  for (int k = 0; k < 3; ++k) {
+    s.time_startup_ns = static_cast<std::uint64_t>(4'900'000'000 + k * 100'000'000);
+    input_.on_vn100(s, 4'900'000'000 + k * 100'000'000);
+  }
+  const pose::PoseQuery q = buffer_.pose_at(5'010'000'000);
+  ASSERT_TRUE(q.valid()) << pose::to_string(q.status);
+  EXPECT_NEAR(q.global_from_robot.translation().x(), 0.3, 1e-4);
+  EXPECT_NEAR(q.global_from_robot.translation().y(), 1.0, 1e-4);
+  // Facing true north: +90° in ENU.
+  const double yaw = std::atan2(q.global_from_robot.linear()(1, 0), q.global_from_robot.linear()(0, 0));
+  EXPECT_NEAR(yaw, std::numbers::pi / 2, 1e-6);
+  EXPECT_FALSE(buffer_.pose_at(5'000'000'000).valid());  // before the epoch's mapped time
+}
+
+TEST_F(PoseInputTest, InvalidPositionKeepsTheLastOneWithItsFailingQuality) {
+  input_.gnss_bytes(ublox::encode_nav_pvt(pvt(1000, 36.0, 127.0)), 1'030'000'000);
+  ublox::NavPvt lost = pvt(1125, 0.0, 0.0);
+  lost.fix_type_raw = 0;
+  lost.gnss_fix_ok = false;
+  lost.invalid_llh = true;
+  input_.gnss_bytes(ublox::encode_nav_pvt(lost), 1'155'000'000);
+  EXPECT_EQ(input_.counters().fixes, 2u);
+  EXPECT_EQ(input_.counters().invalid_position, 1u);
+  const std::vector<std::uint8_t> four_bytes{1, 2, 3, 4};
+  const std::vector<std::uint8_t> short_pvt = ublox::encode_frame(0x01, 0x07, four_bytes);  // a 4-byte NAV-PVT
+  input_.gnss_bytes(short_pvt, 1'200'000'000);
+  EXPECT_EQ(input_.counters().malformed, 1u);
+  EXPECT_EQ(input_.gnss_framing().checksum_errors, 0u);
+}
+
+}  // namespace
+}  // namespace trajroi::pose_input
