@@ -56,6 +56,11 @@ TEST(Scenario, ShippedScenariosParse) {
   EXPECT_DOUBLE_EQ(f.robot.speed_mps, 0.5);
   EXPECT_DOUBLE_EQ(f.evaluation.circle_diameter_m, 28.0);
   EXPECT_EQ(f.gnss.noise_h_m, 0.0);  // noise-free like the paper's Gazebo poses
+  const Scenario o = load_scenario(std::string(TRAJROI_SOURCE_DIR) + "/config/scenarios/outdoor.yaml");
+  ASSERT_EQ(o.gnss.faults.size(), 2u);
+  EXPECT_EQ(o.gnss.faults[1].kind, GnssFault::Kind::kLost);
+  EXPECT_DOUBLE_EQ(o.gnss.faults[1].from_s, 80.0);
+  EXPECT_DOUBLE_EQ(o.gnss.faults[0].h_acc_m, 0.3);
 }
 
 TEST(Scenario, MinimalScenarioTakesTheDefaults) {

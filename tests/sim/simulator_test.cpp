@@ -209,7 +209,7 @@ trajectory:
   segments: [{line: 3}, {arc: {radius: 3, turn_deg: 60}}, {line: 2}]
 robot: {speed_mps: 1.5, wait_before_s: 1, wait_after_s: 0.5, lidar_mount: {xyz: [0.2, 0, 0.7], yaw_deg: 2}}
 lidar: {rpm: 600, return_mode: dual, range_noise_m: 0.01}
-gnss: {noise_h_m: 0.02, noise_v_m: 0.03, correlation_s: 5}
+gnss: {noise_h_m: 0.02, noise_v_m: 0.03, correlation_s: 5, faults: [{kind: lost, from_s: 4.0, to_s: 4.5}]}
 imu: {angle_noise_deg: 0.05, heading_bias_deg: 0.3, magnetic_declination_deg: -8.5}
 evaluation:
   circle_diameter_m: 12
@@ -269,7 +269,13 @@ TEST_F(RunFolder, DecodedPointsMatchTheTruthExactly) {
 TEST_F(RunFolder, DecodedPoseIsTheTruePoseWithinTheConfiguredNoise) {
   const eval::ScenarioRun run(*dir_);
   EXPECT_EQ(run.pose_counters().fixes, report_->stats.gnss_epochs);
-  EXPECT_EQ(run.pose_counters().high_precision, report_->stats.gnss_epochs);
+  EXPECT_EQ(run.pose_counters().invalid_position, 4u);  // 0.5 s of lost fix at 8 Hz
+  EXPECT_EQ(run.pose_counters().high_precision, report_->stats.gnss_epochs - 4);
+  // While the fix is lost the gate refuses the pose, and says why.
+  const std::int64_t start = run.scenario().start_utc_ns;
+  EXPECT_EQ(run.poses().pose_at(start + 4'250'000'000).status, pose::PoseStatus::kFixTypeTooLow);
+  EXPECT_TRUE(run.poses().pose_at(start + 3'800'000'000).valid());
+  EXPECT_TRUE(run.poses().pose_at(start + 4'800'000'000).valid());
   EXPECT_EQ(run.pose_counters().attitudes, report_->stats.imu_frames);
   double worst_position = 0.0, worst_yaw_deg = 0.0;
   std::size_t checked = 0;

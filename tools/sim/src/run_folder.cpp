@@ -343,7 +343,7 @@ std::vector<std::uint8_t> read_truth_labels(const fs::path& file) {
     throw std::runtime_error(file.string() + ": its size does not match its point count");
   }
   std::vector<std::uint8_t> labels(count);
-  for (std::uint64_t i = 0; i < count; ++i) labels[i] = (b[24 + i / 8] >> (i % 8)) & 1U;
+  for (std::uint64_t i = 0; i < count; ++i) labels[i] = static_cast<std::uint8_t>((unsigned{b[24 + i / 8]} >> (i % 8)) & 1U);
   return labels;
 }
 

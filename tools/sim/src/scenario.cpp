@@ -170,6 +170,7 @@ GnssSpec read_gnss(MapReader g) {
     const double default_noise = fault.kind == GnssFault::Kind::kFloat ? 0.15 : 1.0;
     fault.noise_m = non_negative(f, "noise_m", fault.kind == GnssFault::Kind::kLost ? 0.0 : default_noise);
     fault.h_acc_m = positive(f, "h_acc_m", fault.kind == GnssFault::Kind::kLost ? 50.0 : 2.0 * default_noise);
+    gnss.faults.push_back(fault);
   });
   g.finish();
   return gnss;
