@@ -67,6 +67,14 @@ void MapReader::fail(std::string_view key, std::string_view problem) const {
   throw ConfigError(message);
 }
 
+void MapReader::missing(std::string_view key) const {
+  std::string message = located(source(), line_of(state_->node));
+  message += ": ";
+  message += path(key);
+  message += ": missing (required)";
+  throw ConfigError(message);
+}
+
 bool MapReader::has(std::string_view key) const { return static_cast<bool>(node(key)); }
 
 YAML::Node MapReader::node(std::string_view key) const {
@@ -79,11 +87,7 @@ YAML::Node MapReader::node(std::string_view key) const {
 YAML::Node MapReader::scalar(std::string_view key) {
   const YAML::Node value = node(key);
   if (!value) {
-    std::string message = located(source(), line_of(state_->node));
-    message += ": ";
-    message += path(key);
-    message += ": missing (required)";
-    throw ConfigError(message);
+    missing(key);
   }
   state_->used.emplace(key);
   if (!value.IsScalar()) fail(key, "must be a single value");
@@ -129,11 +133,7 @@ bool MapReader::boolean(std::string_view key, bool fallback) {
 std::vector<double> MapReader::numbers(std::string_view key, std::size_t count) {
   const YAML::Node list = node(key);
   if (!list) {
-    std::string message = located(source(), line_of(state_->node));
-    message += ": ";
-    message += path(key);
-    message += ": missing (required)";
-    throw ConfigError(message);
+    missing(key);
   }
   state_->used.emplace(key);
   if (!list.IsSequence() || list.size() != count) fail(key, "must be a list of " + std::to_string(count) + " numbers");
@@ -171,11 +171,7 @@ std::string MapReader::choice(std::string_view key, std::initializer_list<std::s
 MapReader MapReader::map(std::string_view key, bool optional) {
   YAML::Node value = node(key);
   if (!value && !optional) {
-    std::string message = located(source(), line_of(state_->node));
-    message += ": ";
-    message += path(key);
-    message += ": missing (required)";
-    throw ConfigError(message);
+    missing(key);
   }
   state_->used.emplace(key);
   if (value && !value.IsMap()) fail(key, "must be a mapping of keys");

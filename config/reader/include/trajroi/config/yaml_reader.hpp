@@ -76,6 +76,7 @@ class MapReader {
   struct State;
   explicit MapReader(std::unique_ptr<State> state);
   [[nodiscard]] YAML::Node node(std::string_view key) const;
+  [[noreturn]] void missing(std::string_view key) const;
   [[nodiscard]] YAML::Node scalar(std::string_view key);
   std::unique_ptr<State> state_;
 };
