@@ -35,6 +35,14 @@ TEST_F(Cli, SimRefusesABadScenarioAndWritesNothing) {
   for (const auto& entry : fs::directory_iterator(dir_)) EXPECT_EQ(entry.path().filename().string().find(".run"), std::string::npos);
 }
 
+TEST_F(Cli, EvalArtificialSpeaksJsonToo) {
+  const CommandResult r = run("eval artificial --data straight --shape circular --reps 1 --format json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.find("{\"reps\": 1, \"rows\": [\n  {\"data\": \"straight\", \"shape\": \"circular\", \"ratio_pct\": 150,"), 0u) << r.out;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 9);  // 7 rows, the opening and the close
+  EXPECT_EQ(r.out.find("\"fast_equals_reference\": false"), std::string::npos);
+}
+
 TEST_F(Cli, EvalOnAFolderThatIsNotARunIsAClearError) {
   fs::create_directories(dir_ / "empty");
   for (const char* sub : {"keyframes", "sequential", "accumulated"}) {

@@ -97,32 +97,52 @@ void print_table_row(const eval::ArtificialRow& r) {
               reference, fast, r.reference.avg_ms / r.fast.avg_ms);
 }
 
+void print_json_row(const eval::ArtificialRow& r, bool first) {
+  const roi::Confusion& c = r.confusion;
+  std::printf("%s\n  {\"data\": \"%s\", \"shape\": \"%s\", \"ratio_pct\": %d, \"num_roi\": %zu, \"tp\": %llu, \"fp\": %llu, "
+              "\"fn\": %llu, \"tn\": %llu, \"precision\": %.6f, \"recall\": %.6f, \"accuracy\": %.6f, "
+              "\"fast_equals_reference\": %s, \"reference\": {\"min_ms\": %.4f, \"max_ms\": %.4f, \"avg_ms\": %.4f}, "
+              "\"fast\": {\"min_ms\": %.4f, \"max_ms\": %.4f, \"avg_ms\": %.4f}}",
+              first ? "" : ",", std::string(to_string(r.data)).c_str(), std::string(to_string(r.shape)).c_str(), r.ratio_pct,
+              r.centres.size(), static_cast<unsigned long long>(c.tp), static_cast<unsigned long long>(c.fp),
+              static_cast<unsigned long long>(c.fn), static_cast<unsigned long long>(c.tn), c.precision(), c.recall(),
+              c.accuracy(), r.fast_equals_reference ? "true" : "false", r.reference.min_ms, r.reference.max_ms,
+              r.reference.avg_ms, r.fast.min_ms, r.fast.max_ms, r.fast.avg_ms);
+}
+
 void run_artificial(const ArtificialOptions& options) {
   const bool csv = options.format == "csv";
+  const bool json = options.format == "json";
   if (!options.svg_dir.empty()) std::filesystem::create_directories(options.svg_dir);
   if (csv) print_csv_header();
+  if (json) std::printf("{\"reps\": %d, \"rows\": [", options.reps);
+  bool first = true;
   bool all_equal = true;
   for (const eval::ArtificialData data : selected_data(options.data)) {
     const eval::ArtificialScene scene = eval::make_artificial_scene(data);
     for (const eval::RoiShape shape : selected_shapes(options.shape)) {
-      if (!csv) print_table_header(data, shape, scene.points.size(), options.reps);
+      if (!csv && !json) print_table_header(data, shape, scene.points.size(), options.reps);
       for (const int ratio : eval::kPaperRatiosPct) {
         const eval::ArtificialRow row = eval::run_artificial_row(scene, shape, ratio, options.reps);
         all_equal = all_equal && row.fast_equals_reference;
         if (csv) {
           print_csv_row(row);
+        } else if (json) {
+          print_json_row(row, first);
         } else {
           print_table_row(row);
         }
+        first = false;
         if (!options.svg_dir.empty()) write_row_svg(options.svg_dir, scene, row);
         std::fflush(stdout);
       }
     }
   }
+  if (json) std::printf("\n]}\n");
   if (!all_equal) {
     throw std::runtime_error("the fast filter kept a different set of points than the reference");
   }
-  if (!csv) std::printf("\nfast filter == reference double loop on every point of every row\n");
+  if (!csv && !json) std::printf("\nfast filter == reference double loop on every point of every row\n");
 }
 
 }  // namespace
@@ -144,7 +164,7 @@ void add_eval_commands(CLI::App& app) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   artificial->add_option("--format", options->format, "Output format")
-      ->check(CLI::IsMember({"table", "csv"}))
+      ->check(CLI::IsMember({"table", "csv", "json"}))
       ->capture_default_str();
   artificial->add_option("--svg", options->svg_dir,
                          "Write one top-down SVG per row (TP/FP/FN/TN, ROIs, trajectory) here");
