@@ -12,8 +12,6 @@
 #include "trajroi/eval/scenario_eval.hpp"
 #include "trajroi/eval/svg.hpp"
 #include "trajroi/roi/cuboid.hpp"
-#include "trajroi/roi/grid_filter.hpp"
-#include "trajroi/roi/shapes.hpp"
 
 namespace trajroi::cli {
 namespace {
@@ -298,25 +296,12 @@ void run_render(const RenderOptions& o) {
   }
   // The trajectory ROIs, from the robot to the end of the trajectory at 25 % (the paper's
   // Table 20 set-up).
+  eval::RoiChain chain(e);
   for (const eval::RoiShape shape : {eval::RoiShape::kCircular, eval::RoiShape::kRectangular}) {
     const bool circles = shape == eval::RoiShape::kCircular;
-    std::vector<roi::Centre> centres;
-    roi::place_centres(run.trajectory(), c->s0_m, std::numeric_limits<double>::infinity(),
-                       0.25 * (circles ? e.circle_diameter_m : e.rect_height_m), centres);
-    roi::IndexVector kept;
-    if (circles) {
-      const roi::CircularRoiSet set(e.circle_diameter_m / 2.0, centres);
-      roi::GridFilter<roi::CircularRoiSet> grid;
-      grid.build(set);
-      (void)grid.filter(points, kept);
-    } else {
-      const roi::RectangularRoiSet set(e.rect_height_m, e.rect_width_m, centres);
-      roi::GridFilter<roi::RectangularRoiSet> grid;
-      grid.build(set);
-      (void)grid.filter(points, kept);
-    }
-    eval::SvgCanvas& canvas = panel(circles ? "Circular ROI (25 %)" : "Rectangular ROI (25 %)", &kept);
-    eval::draw_chain(canvas, centres, circles, circles ? e.circle_diameter_m : e.rect_height_m, e.rect_width_m);
+    chain.run(run.trajectory(), c->s0_m, std::numeric_limits<double>::infinity(), shape, 25, points);
+    eval::SvgCanvas& canvas = panel(circles ? "Circular ROI (25 %)" : "Rectangular ROI (25 %)", &chain.kept());
+    eval::draw_chain(canvas, chain.centres(), circles, circles ? e.circle_diameter_m : e.rect_height_m, e.rect_width_m);
   }
   write_file_atomically(o.out, eval::side_by_side(panels));
   std::printf("%s: %s, frame %llu, %zu points → %s\n", run.scenario().name.c_str(), c->keyframe.name.c_str(),

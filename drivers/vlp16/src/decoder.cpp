@@ -9,7 +9,6 @@ namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 constexpr double kCentidegToRad = kDegToRad / 100.0;
-constexpr double kBlockDuration_us = 2.0 * kFiringCycle_us;  // two firings: 110.592
 constexpr std::size_t kChannels = kFiringsPerBlock * kLasers;
 
 // Up to this azimuth step between firings (5°; a VLP-16 at 20 Hz steps 0.8°) the in-block
@@ -17,11 +16,6 @@ constexpr std::size_t kChannels = kFiringsPerBlock * kLasers;
 // 1e-11) is far below float resolution. Larger steps only occur in damaged data; they take
 // the library cos/sin.
 constexpr std::uint32_t kSeriesGapLimit_cdeg = 500;
-
-// The azimuth advance from `from` to `to`, hundredths of a degree, across the 0/360 wrap.
-std::uint32_t azimuth_gap(std::uint16_t from, std::uint16_t to) noexcept {
-  return (static_cast<std::uint32_t>(to) + kAzimuthLimit - from) % kAzimuthLimit;
-}
 
 struct CosSin {
   double c, s;
@@ -80,12 +74,11 @@ PacketDecoder::PacketDecoder(const Calibration& calibration, DecodeOptions optio
     rotation_corrected_ = rotation_corrected_ || cal.rot_correction_rad != 0.0;
   }
   for (std::size_t channel = 0; channel < kChannels; ++channel) {
-    const double in_block_us = static_cast<double>(channel / kLasers) * kFiringCycle_us +
-                               static_cast<double>(channel % kLasers) * kLaserPeriod_us;
-    azimuth_fraction_[channel] = in_block_us / kBlockDuration_us;
+    azimuth_fraction_[channel] = azimuth_fraction(channel);
+    const auto in_block_ns = static_cast<std::int64_t>(channel / kLasers) * kFiringCycle_ns +
+                             static_cast<std::int64_t>(channel % kLasers) * kLaserPeriod_ns;
     for (std::size_t pair = 0; pair < kBlocks; ++pair) {
-      const double time_us = static_cast<double>(pair) * kBlockDuration_us + in_block_us;
-      time_ns_[pair][channel] = static_cast<std::uint32_t>(std::lround(time_us * 1000.0));
+      time_ns_[pair][channel] = static_cast<std::uint32_t>(static_cast<std::int64_t>(pair) * kBlockDuration_ns + in_block_ns);
     }
   }
 }

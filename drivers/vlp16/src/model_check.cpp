@@ -8,7 +8,6 @@
 namespace trajroi::vlp16 {
 namespace {
 
-constexpr double kBlockDuration_us = 2.0 * kFiringCycle_us;
 constexpr double kPeriodTolerance = 0.05;  // ±5 % of one or two packet periods
 constexpr double kMinRotation_hz = 4.5;    // the VLP-16 spins at 300 … 1200 rpm
 constexpr double kMaxRotation_hz = 21.0;

@@ -7,14 +7,9 @@
 namespace trajroi::vlp16 {
 namespace {
 
-constexpr double kBlockDuration_us = 2.0 * kFiringCycle_us;
 constexpr double kLossFactor = 1.5;  // a step beyond 1.5 expected ones means packets are missing
 // Points reserved for a frame: a dual-return sweep at 5 Hz is about 300 packets of up to 384.
 constexpr std::size_t kFrameReserve = 300 * kBlocks * kFiringsPerBlock * kLasers;
-
-std::uint32_t azimuth_gap(std::uint16_t from, std::uint16_t to) noexcept {
-  return (static_cast<std::uint32_t>(to) + kAzimuthLimit - from) % kAzimuthLimit;
-}
 
 // Packets missing in a step of `observed` where `expected` was due, at least one.
 std::uint32_t missing(double observed, double expected) noexcept {

@@ -12,6 +12,7 @@
 #include "trajroi/config/yaml_reader.hpp"
 #include "trajroi/roi/grid_filter.hpp"
 #include "trajroi/roi/shapes.hpp"
+#include "trajroi/roi/transform.hpp"
 #include "trajroi/serial/byte_log.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
 
@@ -19,11 +20,6 @@ namespace trajroi::eval {
 namespace fs = std::filesystem;
 namespace {
 
-constexpr std::int64_t kFiringSequence_ns = 55'296;
-// Bytes of one GNSS epoch (NAV-HPPOSLLH + NAV-PVT) and of one simulated VN-100 frame: the
-// transmission part of the delay from a sample to its receipt.
-constexpr double kGnssEpochBytes = 144.0;
-constexpr double kImuFrameBytes = 50.0;
 
 std::string read_file_text(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -31,15 +27,6 @@ std::string read_file_text(const fs::path& path) {
   std::ostringstream text;
   text << in.rdbuf();
   return std::move(text).str();
-}
-
-Eigen::Isometry3d mounting_pose(const sim::Mounting& m) {
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.translation() = m.xyz_m;
-  t.linear() = (Eigen::AngleAxisd(m.yaw_rad, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(m.pitch_rad, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(m.roll_rad, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  return t;
 }
 
 template <typename Point>
@@ -83,39 +70,6 @@ class TruthCorridor {
   Eigen::Vector2d start_, end_, start_dir_, end_dir_;
 };
 
-double size_along(const sim::EvaluationSpec& e, RoiShape shape) {
-  return shape == RoiShape::kCircular ? e.circle_diameter_m : e.rect_height_m;
-}
-
-// Centres, ROI set, grid and filter for one cloud; the set and the grid are reused.
-struct RoiRunner {
-  explicit RoiRunner(const sim::EvaluationSpec& e)
-      : eval(e), circles(e.circle_diameter_m / 2.0, {}), rects(e.rect_height_m, e.rect_width_m, {}) {}
-
-  void run(const roi::Trajectory& trajectory, double s0, RoiShape shape, int ratio_pct,
-           std::span<const roi::PointXYZI> points) {
-    const double spacing = roi::spacing_from_ratio(ratio_pct / 100.0, size_along(eval, shape));
-    roi::place_centres(trajectory, s0, eval.look_ahead_m, spacing, centres);
-    if (shape == RoiShape::kCircular) {
-      circles.assign(centres);
-      circle_grid.build(circles);
-      circle_grid.filter(points, kept);
-    } else {
-      rects.assign(centres);
-      rect_grid.build(rects);
-      rect_grid.filter(points, kept);
-    }
-  }
-
-  const sim::EvaluationSpec& eval;
-  std::vector<roi::Centre> centres;
-  roi::CircularRoiSet circles;
-  roi::RectangularRoiSet rects;
-  roi::GridFilter<roi::CircularRoiSet> circle_grid;
-  roi::GridFilter<roi::RectangularRoiSet> rect_grid;
-  roi::IndexVector kept;
-};
-
 double elapsed_ms(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
 }
@@ -129,14 +83,35 @@ void add_sample(TimingStats& t, std::size_t& n, double ms) {
 
 }  // namespace
 
+// ---- RoiChain -----------------------------------------------------------------------------
+
+RoiChain::RoiChain(const sim::EvaluationSpec& spec)
+    : spec_(spec), circles_(spec.circle_diameter_m / 2.0, {}), rects_(spec.rect_height_m, spec.rect_width_m, {}) {}
+
+void RoiChain::run(const roi::Trajectory& trajectory, double s0_m, double look_ahead_m, RoiShape shape, int ratio_pct,
+                   std::span<const roi::PointXYZI> points) {
+  const bool circular = shape == RoiShape::kCircular;
+  const double spacing = roi::spacing_from_ratio(ratio_pct / 100.0, circular ? spec_.circle_diameter_m : spec_.rect_height_m);
+  roi::place_centres(trajectory, s0_m, look_ahead_m, spacing, centres_);
+  if (circular) {
+    circles_.assign(centres_);
+    circle_grid_.build(circles_);
+    circle_grid_.filter(points, kept_);
+  } else {
+    rects_.assign(centres_);
+    rect_grid_.build(rects_);
+    rect_grid_.filter(points, kept_);
+  }
+}
+
 // ---- ScenarioRun ---------------------------------------------------------------------------
 
 ScenarioRun::ScenarioRun(const fs::path& dir) : dir_(dir) {
   sim::require_run_folder(dir);
-  scenario_ = sim::parse_scenario(read_file_text(dir / sim::kScenarioFile), (dir / sim::kScenarioFile).string());
+  scenario_ = sim::load_scenario(dir / sim::kScenarioFile);
   trajectory_ = std::make_unique<roi::Trajectory>(
       roi::parse_trajectory_csv(read_file_text(dir / sim::kTrajectoryFile), (dir / sim::kTrajectoryFile).string()));
-  robot_from_lidar_ = mounting_pose(scenario_.robot.lidar);
+  robot_from_lidar_ = scenario_.robot.lidar.robot_from_sensor();
 
   // The pose, from the recorded streams through the drivers and the pose library. The gate
   // is the daemon's default; the buffer holds the whole run (an offline evaluation).
@@ -145,23 +120,23 @@ ScenarioRun::ScenarioRun(const fs::path& dir) : dir_(dir) {
   poses_ = std::make_unique<pose::PoseBuffer>(gate, scenario_.robot.gnss_antenna_m, capacity);
   pose_input::PoseInputConfig config;
   config.imu.magnetic_declination_deg = scenario_.imu.magnetic_declination_deg;
-  config.gnss_delay_ns = std::llround((scenario_.gnss.latency_s + kGnssEpochBytes * 10.0 / scenario_.gnss.baud) * 1e9);
-  config.imu_delay_ns = std::llround((scenario_.imu.latency_s + kImuFrameBytes * 10.0 / scenario_.imu.baud) * 1e9);
+  config.gnss_delay_ns = std::llround(sim::gnss_delay_s(scenario_.gnss) * 1e9);
+  config.imu_delay_ns = std::llround(sim::imu_delay_s(scenario_.imu) * 1e9);
   pose_input::PoseInput input(pose::GlobalFrame::local_cartesian(scenario_.origin), config, *poses_);
-  // Attitudes first: a fix's attitude rotation uses the latest position, which the GNSS
-  // stream gives; feeding GNSS first gives every attitude a position (the run is offline).
-  {
-    serial::ReplaySource gnss((dir / sim::kGnssFile).string());
-    serial::Chunk chunk;
-    while (gnss.read(chunk, std::chrono::milliseconds(0)) == serial::ReadStatus::kData) {
-      input.gnss_bytes(chunk.bytes, chunk.receive_time_ns);
-    }
-  }
-  {
-    serial::ReplaySource imu((dir / sim::kImuFile).string());
-    serial::Chunk chunk;
-    while (imu.read(chunk, std::chrono::milliseconds(0)) == serial::ReadStatus::kData) {
-      input.imu_bytes(chunk.bytes, chunk.receive_time_ns);
+  // The two recordings in receive-time order, as a live daemon gets them (an attitude is
+  // turned into the global frame at the latest GNSS position).
+  serial::ReplaySource gnss((dir / sim::kGnssFile).string());
+  serial::ReplaySource imu((dir / sim::kImuFile).string());
+  serial::Chunk g, i;
+  bool have_g = gnss.read(g, std::chrono::milliseconds(0)) == serial::ReadStatus::kData;
+  bool have_i = imu.read(i, std::chrono::milliseconds(0)) == serial::ReadStatus::kData;
+  while (have_g || have_i) {
+    if (have_g && (!have_i || g.receive_time_ns <= i.receive_time_ns)) {
+      input.gnss_bytes(g.bytes, g.receive_time_ns);
+      have_g = gnss.read(g, std::chrono::milliseconds(0)) == serial::ReadStatus::kData;
+    } else {
+      input.imu_bytes(i.bytes, i.receive_time_ns);
+      have_i = imu.read(i, std::chrono::milliseconds(0)) == serial::ReadStatus::kData;
     }
   }
   pose_counters_ = input.counters();
@@ -222,7 +197,7 @@ bool place_frame(const vlp16::Frame& frame, const pose::PoseBuffer& poses, const
   for (const vlp16::Point& p : frame.points) {
     if (mode == PoseMode::kPerFiring) {
       const std::int64_t t = frame.start_time_ns + p.time_offset_ns;
-      if (!have_pose || t - pose_time >= kFiringSequence_ns || t < pose_time) {
+      if (!have_pose || t - pose_time >= vlp16::kFiringCycle_ns || t < pose_time) {
         const pose::PoseQuery q = poses.pose_at(t);
         status = q.status;
         if (!q.valid()) return false;
@@ -243,10 +218,8 @@ void place_frame_truth(const vlp16::Frame& frame, const sim::TruthPoses& truth,
   out.reserve(frame.points.size());
   for (const vlp16::Point& p : frame.points) {
     const sim::TruePose tp = truth.at(frame.start_time_ns + p.time_offset_ns);
-    Eigen::Isometry3d global_from_robot = Eigen::Isometry3d::Identity();
-    global_from_robot.translation() = Eigen::Vector3d(tp.x_m, tp.y_m, 0.0);
-    global_from_robot.linear() = Eigen::AngleAxisd(tp.yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    push_point(out, (global_from_robot * robot_from_lidar) * Eigen::Vector3d(p.x, p.y, p.z), 0.0f);
+    const Eigen::Isometry3d global_from_lidar = roi::pose_from_xy_yaw(tp.x_m, tp.y_m, tp.yaw_rad) * robot_from_lidar;
+    push_point(out, global_from_lidar * Eigen::Vector3d(p.x, p.y, p.z), 0.0f);
   }
 }
 
@@ -305,15 +278,15 @@ KeyframeRow run_keyframe_row(const ScenarioRun& run, const KeyframeCase& c, RoiS
                              PoseMode mode) {
   const sim::EvaluationSpec& e = run.scenario().evaluation;
   KeyframeRow row{c.keyframe.name, shape, ratio_pct, {}, {}, {}, {}, {}};
-  RoiRunner runner(e);
+  RoiChain chain(e);
   std::vector<roi::PointXYZI> placed;
   pose::PoseStatus status{};
   row.time = time_repeated(reps, [&] {
     (void)place_frame(c.frame, run.poses(), run.robot_from_lidar(), mode, placed, status);
-    runner.run(run.trajectory(), c.s0_m, shape, ratio_pct, placed);
+    chain.run(run.trajectory(), c.s0_m, e.look_ahead_m, shape, ratio_pct, placed);
   });
-  row.centres = runner.centres;
-  row.kept = runner.kept;
+  row.centres = chain.centres();
+  row.kept = chain.kept();
   const bool circles = shape == RoiShape::kCircular;
   const double half_a = circles ? 0.0 : e.rect_height_m / 2.0;
   const TruthCorridor corridor(run.trajectory(), row.centres, half_a, circles ? e.circle_diameter_m : e.rect_width_m,
@@ -328,7 +301,8 @@ KeyframeRow run_keyframe_row(const ScenarioRun& run, const KeyframeCase& c, RoiS
 
 SequentialReport run_sequential(const ScenarioRun& run, PoseMode mode, int ratio_pct) {
   SequentialReport report;
-  RoiRunner runner(run.scenario().evaluation);
+  RoiChain chain(run.scenario().evaluation);
+  const double look_ahead = run.scenario().evaluation.look_ahead_m;
   std::vector<roi::PointXYZI> placed;
   std::size_t n_cycle = 0, n_circ = 0, n_rect = 0;
   std::int64_t previous_start = 0, first_start = 0;
@@ -351,6 +325,7 @@ SequentialReport run_sequential(const ScenarioRun& run, PoseMode mode, int ratio
     previous_start = frame.start_time_ns;
     ft.start_s = static_cast<double>(frame.start_time_ns - first_start) * 1e-9;
 
+    // Each shape is timed as the whole pipeline, so the frame is placed once per shape.
     for (const RoiShape shape : {RoiShape::kCircular, RoiShape::kRectangular}) {
       const auto start = std::chrono::steady_clock::now();
       pose::PoseStatus status{};
@@ -361,7 +336,7 @@ SequentialReport run_sequential(const ScenarioRun& run, PoseMode mode, int ratio
       const pose::PoseQuery q = run.poses().pose_at(frame.end_time_ns);
       if (!q.valid()) return;
       const double s0 = run.trajectory().project(q.global_from_robot.translation().head<2>(), s_hint, 50.0).s_m;
-      runner.run(run.trajectory(), s0, shape, ratio_pct, placed);
+      chain.run(run.trajectory(), s0, look_ahead, shape, ratio_pct, placed);
       const double ms = decode_ms + elapsed_ms(start);
       if (shape == RoiShape::kCircular) {
         ft.circular_ms = ms;
@@ -418,7 +393,8 @@ AccumulatedReport run_accumulated(const ScenarioRun& run, PoseMode mode, int rat
   std::vector<Accumulator> acc;
   for (const int n : kAccumulations) acc.push_back({n, 0, {}, {0, 0}, 0.0, {}});
   AccumulatedReport report;
-  RoiRunner runner(run.scenario().evaluation);
+  RoiChain chain(run.scenario().evaluation);
+  const double look_ahead = run.scenario().evaluation.look_ahead_m;
   std::vector<roi::PointXYZI> placed;
   double s_hint = 0.0;
   run.for_each_frame([&](const vlp16::Frame& frame, std::uint64_t, double) {
@@ -435,7 +411,7 @@ AccumulatedReport run_accumulated(const ScenarioRun& run, PoseMode mode, int rat
       for (const RoiShape shape : {RoiShape::kCircular, RoiShape::kRectangular}) {
         const int k = shape == RoiShape::kCircular ? 0 : 1;
         const auto start = std::chrono::steady_clock::now();
-        runner.run(run.trajectory(), s0, shape, ratio_pct, a.cloud);
+        chain.run(run.trajectory(), s0, look_ahead, shape, ratio_pct, a.cloud);
         const double ms = elapsed_ms(start);
         add_sample(a.time[k], a.clouds[k], ms);
         (k == 0 ? report.circular_samples : report.rectangular_samples)

@@ -27,7 +27,7 @@ PathPose Path::at(double s_m) const noexcept {
   s_m = std::clamp(s_m, 0.0, length_m_);
   auto it = std::upper_bound(pieces_.begin(), pieces_.end(), s_m,
                              [](double s, const Piece& piece) { return s < piece.s0_m; });
-  const Piece& p = *std::prev(it == pieces_.begin() ? std::next(it) : it);
+  const Piece& p = it == pieces_.begin() ? *it : *std::prev(it);
   const double u = std::min(s_m - p.s0_m, p.length_m());
   const double c0 = std::cos(p.heading_rad);
   const double s0 = std::sin(p.heading_rad);

@@ -56,7 +56,6 @@ class BinaryFile {
   std::FILE* file_;
 };
 
-void append_u32(std::vector<std::uint8_t>& out, std::uint32_t v) { framing::put_le_u32(out, v); }
 void append_f64(std::vector<std::uint8_t>& out, double v) { framing::put_le_u64(out, std::bit_cast<std::uint64_t>(v)); }
 
 std::vector<std::uint8_t> read_all(const fs::path& file) {
@@ -138,8 +137,8 @@ class FolderSink final : public SimulationSink {
         poses_(dir / kTruthPosesFile),
         labels_(dir / kTruthLabelsFile) {
     std::vector<std::uint8_t> header(std::begin(kPosesMagic), std::end(kPosesMagic));
-    append_u32(header, kTruthVersion);
-    append_u32(header, kPoseRecordBytes);
+    framing::put_le_u32(header, kTruthVersion);
+    framing::put_le_u32(header, kPoseRecordBytes);
     poses_.write(header.data(), header.size());
     write_labels_header();
   }
@@ -185,8 +184,8 @@ class FolderSink final : public SimulationSink {
  private:
   void write_labels_header() {
     std::vector<std::uint8_t> header(std::begin(kLabelsMagic), std::end(kLabelsMagic));
-    append_u32(header, kTruthVersion);
-    append_u32(header, 0);
+    framing::put_le_u32(header, kTruthVersion);
+    framing::put_le_u32(header, 0);
     framing::put_le_u64(header, label_count_);
     labels_.write(header.data(), header.size());
   }
@@ -227,11 +226,11 @@ std::string daemon_config(const Scenario& s) {
       "  replay: %s\n"
       "gnss:\n"
       "  antenna: [%.4f, %.4f, %.4f]\n"
-      "  latency_s: %.6f\n"
+      "  delay_s: %.6f    # epoch → receipt of its NAV-PVT (latency + transmission)\n"
       "  replay: %s\n"
       "imu:\n"
       "  magnetic_declination_deg: %.4f\n"
-      "  latency_s: %.6f\n"
+      "  delay_s: %.6f    # sample → receipt of its frame\n"
       "  replay: %s\n"
       "roi:\n"
       "  shape: circular\n"
@@ -242,8 +241,8 @@ std::string daemon_config(const Scenario& s) {
       "  look_ahead_m: %.3f\n",
       s.name.c_str(), s.origin.lat_deg, s.origin.lon_deg, s.origin.height_m, kTrajectoryFile, m.xyz_m.x(), m.xyz_m.y(),
       m.xyz_m.z(), m.roll_rad * kRadToDeg, m.pitch_rad * kRadToDeg, m.yaw_rad * kRadToDeg, s.lidar.max_range_m,
-      kLidarFile, s.robot.gnss_antenna_m.x(), s.robot.gnss_antenna_m.y(), s.robot.gnss_antenna_m.z(), s.gnss.latency_s,
-      kGnssFile, s.imu.magnetic_declination_deg, s.imu.latency_s, kImuFile, e.circle_diameter_m, e.rect_height_m,
+      kLidarFile, s.robot.gnss_antenna_m.x(), s.robot.gnss_antenna_m.y(), s.robot.gnss_antenna_m.z(), gnss_delay_s(s.gnss),
+      kGnssFile, s.imu.magnetic_declination_deg, imu_delay_s(s.imu), kImuFile, e.circle_diameter_m, e.rect_height_m,
       e.rect_width_m, e.look_ahead_m);
   return text;
 }

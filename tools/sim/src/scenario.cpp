@@ -17,10 +17,6 @@ using config::MapReader;
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 constexpr double kMaxVlp16Range_m = 65535 * vlp16::kDistanceUnit_m;
-// Bytes on the wire per epoch: NAV-HPPOSLLH (36 + 8) and NAV-PVT (92 + 8); per VN-100 frame
-// with TimeStartup, YawPitchRoll, AngularRate and Accel: sync, group, mask, 8 + 3 × 12, CRC.
-constexpr double kGnssBytesPerEpoch = 44 + 100;
-constexpr double kImuBytesPerFrame = 1 + 1 + 2 + 8 + 36 + 2;
 
 double positive(MapReader& r, std::string_view key, double fallback) {
   const double v = r.number(key, fallback);
@@ -154,7 +150,7 @@ GnssSpec read_gnss(MapReader g) {
   gnss.latency_s = non_negative(g, "latency_s", gnss.latency_s);
   g.require(gnss.latency_s < 1.0, "latency_s", "must be below 1 s");
   gnss.baud = positive(g, "baud", gnss.baud);
-  g.require(gnss.baud / 10.0 >= kGnssBytesPerEpoch * gnss.rate_hz, "baud",
+  g.require(gnss.baud / 10.0 >= static_cast<double>(kGnssEpochBytes) * gnss.rate_hz, "baud",
             "too slow for NAV-HPPOSLLH and NAV-PVT at this rate");
   gnss.noise_h_m = non_negative(g, "noise_h_m", 0.0);
   gnss.noise_v_m = non_negative(g, "noise_v_m", 0.0);
@@ -184,7 +180,7 @@ ImuSpec read_imu(MapReader i) {
   imu.latency_s = non_negative(i, "latency_s", 0.0);
   i.require(imu.latency_s < 1.0, "latency_s", "must be below 1 s");
   imu.baud = positive(i, "baud", imu.baud);
-  i.require(imu.baud / 10.0 >= kImuBytesPerFrame * 800.0 / imu.rate_divisor, "baud", "too slow for this output rate");
+  i.require(imu.baud / 10.0 >= static_cast<double>(kImuFrameBytes) * 800.0 / imu.rate_divisor, "baud", "too slow for this output rate");
   imu.angle_noise_deg = non_negative(i, "angle_noise_deg", 0.0);
   imu.gyro_noise_rps = non_negative(i, "gyro_noise_rps", 0.0);
   imu.accel_noise_mps2 = non_negative(i, "accel_noise_mps2", 0.0);
@@ -218,6 +214,15 @@ EvaluationSpec read_evaluation(MapReader e) {
 }
 
 }  // namespace
+
+Eigen::Isometry3d Mounting::robot_from_sensor() const {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = xyz_m;
+  t.linear() = (Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch_rad, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(roll_rad, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  return t;
+}
 
 bool parse_utc_iso8601(std::string_view text, std::int64_t& utc_ns) {
   // YYYY-MM-DDTHH:MM:SS[.fff…]Z

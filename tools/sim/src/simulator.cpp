@@ -10,6 +10,7 @@
 #include "trajroi/pose/geodetic.hpp"
 #include "trajroi/roi/grid_filter.hpp"
 #include "trajroi/roi/shapes.hpp"
+#include "trajroi/roi/transform.hpp"
 #include "trajroi/ublox/messages.hpp"
 #include "trajroi/vlp16/decoder.hpp"
 #include "trajroi/vlp16/encoder.hpp"
@@ -22,10 +23,7 @@ namespace {
 constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 constexpr std::int64_t kSecond_ns = 1'000'000'000;
-constexpr std::int64_t kBlock_ns = 110'592;   // two firing sequences
-constexpr std::int64_t kSequence_ns = 55'296;
-constexpr std::int64_t kLaser_ns = 2'304;
-constexpr std::int64_t kHour_ns = 3'600 * kSecond_ns;
+constexpr std::int64_t kHour_ns = vlp16::kHour_us * 1000;
 // GPS time = UTC + 18 s (leap seconds since 2017-01-01); the GPS epoch 1980-01-06 in UTC.
 constexpr std::int64_t kGpsMinusUtc_ns = 18 * kSecond_ns;
 constexpr std::int64_t kGpsEpochUtc_ns = 315'964'800 * kSecond_ns;
@@ -55,10 +53,7 @@ double wrap_deg(double a) {
 }
 
 Eigen::Isometry3d robot_pose(const RobotState& s) {
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.translation() = Eigen::Vector3d(s.position_m.x(), s.position_m.y(), 0.0);
-  t.linear() = Eigen::AngleAxisd(s.yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  return t;
+  return roi::pose_from_xy_yaw(s.position_m.x(), s.position_m.y(), s.yaw_rad);
 }
 
 }  // namespace
@@ -73,12 +68,6 @@ struct Simulator::Impl {
         trajectory(roi::parse_trajectory_csv(csv, "trajectory.csv")),
         frame(pose::GlobalFrame::local_cartesian(s.origin)),
         corridor(trajectory, 0.0, trajectory.length_m(), s.evaluation.corridor_width_m) {
-    const Mounting& m = s.robot.lidar;
-    robot_from_lidar.translation() = m.xyz_m;
-    robot_from_lidar.linear() = (Eigen::AngleAxisd(m.yaw_rad, Eigen::Vector3d::UnitZ()) *
-                                 Eigen::AngleAxisd(m.pitch_rad, Eigen::Vector3d::UnitY()) *
-                                 Eigen::AngleAxisd(m.roll_rad, Eigen::Vector3d::UnitX()))
-                                    .toRotationMatrix();
     corridor_grid.build(corridor);
   }
 
@@ -95,7 +84,7 @@ struct Simulator::Impl {
   roi::Trajectory trajectory;
   pose::GlobalFrame frame;
   vlp16::Calibration calibration = vlp16::Calibration::vlp16_default();
-  Eigen::Isometry3d robot_from_lidar = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d robot_from_lidar = scenario.robot.lidar.robot_from_sensor();
   roi::CorridorRoiSet corridor;
   roi::GridFilter<roi::CorridorRoiSet> corridor_grid;
 };
@@ -134,7 +123,7 @@ void Simulator::Impl::run_lidar(SimulationSink& sink, SimulationStats& stats,
                                  const std::function<void(double)>& progress) const {
   const LidarSpec& lidar = scenario.lidar;
   const std::size_t blocks_per_packet = vlp16::firing_blocks_per_packet(lidar.return_mode);
-  const std::int64_t period_ns = static_cast<std::int64_t>(blocks_per_packet) * kBlock_ns;
+  const std::int64_t period_ns = static_cast<std::int64_t>(blocks_per_packet) * vlp16::kBlockDuration_ns;
   const double cdeg_per_ns = lidar.rpm * 36'000.0 / 60.0 / 1e9;
   const std::int64_t duration = motion.duration_ns();
 
@@ -169,28 +158,25 @@ void Simulator::Impl::run_lidar(SimulationSink& sink, SimulationStats& stats,
       next_pps += kSecond_ns;
     }
     for (std::size_t b = 0; b < blocks_per_packet; ++b) {
-      const double a = lidar.start_azimuth_deg * 100.0 + static_cast<double>(t_first + static_cast<std::int64_t>(b) * kBlock_ns) * cdeg_per_ns;
+      const double a = lidar.start_azimuth_deg * 100.0 + static_cast<double>(t_first + static_cast<std::int64_t>(b) * vlp16::kBlockDuration_ns) * cdeg_per_ns;
       azimuth[b] = static_cast<std::uint16_t>(std::llround(a) % vlp16::kAzimuthLimit);
     }
     measured.clear();
     for (std::size_t b = 0; b < blocks_per_packet; ++b) {
       // The decoder's interpolation between block azimuths, so every ray leaves at the
       // azimuth its point will be decoded at.
-      const auto gap_of = [](std::uint16_t from, std::uint16_t to) {
-        return static_cast<double>((static_cast<std::uint32_t>(to) + vlp16::kAzimuthLimit - from) % vlp16::kAzimuthLimit);
-      };
-      const double gap = b + 1 < blocks_per_packet ? gap_of(azimuth[b], azimuth[b + 1]) : gap_of(azimuth[b - 1], azimuth[b]);
+      const auto gap = static_cast<double>(b + 1 < blocks_per_packet ? vlp16::azimuth_gap(azimuth[b], azimuth[b + 1])
+                                                                     : vlp16::azimuth_gap(azimuth[b - 1], azimuth[b]));
       vlp16::FiringBlock& block = blocks[b];
       block.azimuth_cdeg = azimuth[b];
       for (std::size_t seq = 0; seq < vlp16::kFiringsPerBlock; ++seq) {
-        const std::int64_t t_seq = t_first + static_cast<std::int64_t>(b) * kBlock_ns + static_cast<std::int64_t>(seq) * kSequence_ns;
+        const std::int64_t t_seq = t_first + static_cast<std::int64_t>(b) * vlp16::kBlockDuration_ns + static_cast<std::int64_t>(seq) * vlp16::kFiringCycle_ns;
         const RobotState at_seq = motion.at(t_seq);
         sink.firing_pose({scenario.start_utc_ns + t_seq, at_seq.position_m.x(), at_seq.position_m.y(), at_seq.yaw_rad});
         for (std::size_t l = 0; l < vlp16::kLasers; ++l) {
           const std::size_t channel = seq * vlp16::kLasers + l;
-          const std::int64_t t = t_seq + static_cast<std::int64_t>(l) * kLaser_ns;
-          const double fraction = (static_cast<double>(seq) * 55.296 + static_cast<double>(l) * 2.304) / 110.592;
-          const double theta = (static_cast<double>(azimuth[b]) + gap * fraction) * (kDegToRad / 100.0);
+          const std::int64_t t = t_seq + static_cast<std::int64_t>(l) * vlp16::kLaserPeriod_ns;
+          const double theta = (static_cast<double>(azimuth[b]) + gap * vlp16::azimuth_fraction(channel)) * (kDegToRad / 100.0);
           const LaserRay& laser = lasers[l];
           const double ct = std::cos(theta), st = std::sin(theta);
           // Sensor frame (the decoder's model): p = R d + o.

@@ -75,25 +75,25 @@ World::World(const WorldSpec& spec, double cell_m) : ground_reflectivity_(spec.g
   cell_start_.push_back(static_cast<std::uint32_t>(items_.size()));
 }
 
-double World::hit_box(const BoxShape& b, const Eigen::Vector3d& o, const Eigen::Vector3d& d) const noexcept {
-  const double rx = o.x() - b.cx, ry = o.y() - b.cy;
-  const double ox = b.cos_yaw * rx + b.sin_yaw * ry;
-  const double oy = -b.sin_yaw * rx + b.cos_yaw * ry;
-  const double dx = b.cos_yaw * d.x() + b.sin_yaw * d.y();
-  const double dy = -b.sin_yaw * d.x() + b.cos_yaw * d.y();
+double World::BoxShape::hit(const Eigen::Vector3d& o, const Eigen::Vector3d& d) const noexcept {
+  const double rx = o.x() - cx, ry = o.y() - cy;
+  const double ox = cos_yaw * rx + sin_yaw * ry;
+  const double oy = -sin_yaw * rx + cos_yaw * ry;
+  const double dx = cos_yaw * d.x() + sin_yaw * d.y();
+  const double dy = -sin_yaw * d.x() + cos_yaw * d.y();
   double lo = -kInf, hi = kInf;
-  if (!slab(ox, dx, -b.half_x, b.half_x, lo, hi) || !slab(oy, dy, -b.half_y, b.half_y, lo, hi) ||
-      !slab(o.z(), d.z(), 0.0, b.height, lo, hi)) {
+  if (!slab(ox, dx, -half_x, half_x, lo, hi) || !slab(oy, dy, -half_y, half_y, lo, hi) ||
+      !slab(o.z(), d.z(), 0.0, height, lo, hi)) {
     return kInf;
   }
   return lo > kEpsilon_m ? lo : kInf;
 }
 
-double World::hit_cylinder(const CylinderShape& c, const Eigen::Vector3d& o, const Eigen::Vector3d& d) const noexcept {
-  const double ox = o.x() - c.cx, oy = o.y() - c.cy;
+double World::CylinderShape::hit(const Eigen::Vector3d& o, const Eigen::Vector3d& d) const noexcept {
+  const double ox = o.x() - cx, oy = o.y() - cy;
   const double a = d.x() * d.x() + d.y() * d.y();
   const double b = ox * d.x() + oy * d.y();
-  const double k = ox * ox + oy * oy - c.radius * c.radius;
+  const double k = ox * ox + oy * oy - radius * radius;
   double lo = -kInf, hi = kInf;
   if (a < 1e-15) {
     if (k > 0.0) return kInf;
@@ -104,7 +104,7 @@ double World::hit_cylinder(const CylinderShape& c, const Eigen::Vector3d& o, con
     lo = (-b - root) / a;
     hi = (-b + root) / a;
   }
-  if (!slab(o.z(), d.z(), 0.0, c.height, lo, hi)) return kInf;
+  if (!slab(o.z(), d.z(), 0.0, height, lo, hi)) return kInf;
   return lo > kEpsilon_m ? lo : kInf;
 }
 
@@ -143,20 +143,11 @@ std::optional<Hit> World::cast(const Eigen::Vector3d& o, const Eigen::Vector3d& 
         const std::size_t cell = static_cast<std::size_t>(j * nx_ + i);
         for (std::uint32_t k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
           const std::uint32_t item = items_[k];
-          double t;
-          std::uint8_t reflectivity;
-          if ((item & kCylinderBit) != 0) {
-            const CylinderShape& c = cylinders_[item & ~kCylinderBit];
-            t = hit_cylinder(c, o, d);
-            reflectivity = c.reflectivity;
-          } else {
-            const BoxShape& b = boxes_[item];
-            t = hit_box(b, o, d);
-            reflectivity = b.reflectivity;
-          }
+          const bool cylinder = (item & kCylinderBit) != 0;
+          const double t = cylinder ? cylinders_[item & ~kCylinderBit].hit(o, d) : boxes_[item].hit(o, d);
           if (t < best) {
             best = t;
-            best_reflectivity = reflectivity;
+            best_reflectivity = cylinder ? cylinders_[item & ~kCylinderBit].reflectivity : boxes_[item].reflectivity;
           }
         }
         const double cell_exit = std::min(t_max_x, t_max_y);

@@ -25,6 +25,11 @@ inline constexpr std::uint16_t kAzimuthLimit = 36000; // hundredths of a degree
 inline constexpr double kDistanceUnit_m = 0.002;
 inline constexpr double kLaserPeriod_us = 2.304;      // between two lasers of one firing
 inline constexpr double kFiringCycle_us = 55.296;     // one firing sequence, recharge included
+inline constexpr double kBlockDuration_us = 2.0 * kFiringCycle_us;  // 110.592: a block's two sequences
+// The same in whole nanoseconds (exact: the manual's figures are multiples of 1 ns).
+inline constexpr std::int64_t kLaserPeriod_ns = 2'304;
+inline constexpr std::int64_t kFiringCycle_ns = 55'296;
+inline constexpr std::int64_t kBlockDuration_ns = 2 * kFiringCycle_ns;
 inline constexpr std::int64_t kHour_us = 3'600'000'000;  // timestamps count µs past the hour
 
 enum class ReturnMode : std::uint8_t { kStrongest = 0x37, kLast = 0x38, kDual = 0x39 };
@@ -68,6 +73,18 @@ inline constexpr auto& read_u32 = framing::le_u32;
 }
 [[nodiscard]] inline std::uint8_t product_id(std::span<const std::uint8_t> p) noexcept {
   return p[kProductIdOffset];
+}
+
+// The azimuth advance from `from` to `to`, hundredths of a degree, across the 0/360 wrap.
+[[nodiscard]] inline std::uint32_t azimuth_gap(std::uint16_t from, std::uint16_t to) noexcept {
+  return (static_cast<std::uint32_t>(to) + kAzimuthLimit - from) % kAzimuthLimit;
+}
+
+// Channel 0 … 31 of a block: its firing time after the block's first, as a fraction of the
+// block's duration — the weight of the azimuth advance that a channel's azimuth takes.
+[[nodiscard]] inline double azimuth_fraction(std::size_t channel) noexcept {
+  return (static_cast<double>(channel / kLasers) * kFiringCycle_us + static_cast<double>(channel % kLasers) * kLaserPeriod_us) /
+         kBlockDuration_us;
 }
 
 // `to − from` for two top-of-hour timestamps, across the hour wrap: in [−½ h, ½ h).

@@ -18,8 +18,10 @@
 #include "trajroi/pose/pose_buffer.hpp"
 #include "trajroi/pose_input/pose_input.hpp"
 #include "trajroi/roi/centres.hpp"
+#include "trajroi/roi/grid_filter.hpp"
 #include "trajroi/roi/metrics.hpp"
 #include "trajroi/roi/point.hpp"
+#include "trajroi/roi/shapes.hpp"
 #include "trajroi/roi/trajectory.hpp"
 #include "trajroi/sim/run_folder.hpp"
 #include "trajroi/sim/scenario.hpp"
@@ -72,6 +74,27 @@ bool place_frame(const vlp16::Frame& frame, const pose::PoseBuffer& poses, const
 // Where the frame's measured points really are: each placed with the true pose at its time.
 void place_frame_truth(const vlp16::Frame& frame, const sim::TruthPoses& truth,
                        const Eigen::Isometry3d& robot_from_lidar, std::vector<roi::PointXYZd>& out);
+
+// A chain of ROIs filtering one cloud: centres from s0 over the look-ahead at a spacing
+// ratio of the shape's size along the trajectory, the ROI set, its grid and the filter. The
+// sets, grids and index storage are reused from call to call.
+class RoiChain {
+ public:
+  explicit RoiChain(const sim::EvaluationSpec& spec);
+  void run(const roi::Trajectory& trajectory, double s0_m, double look_ahead_m, RoiShape shape, int ratio_pct,
+           std::span<const roi::PointXYZI> points);
+  [[nodiscard]] const std::vector<roi::Centre>& centres() const noexcept { return centres_; }
+  [[nodiscard]] const roi::IndexVector& kept() const noexcept { return kept_; }
+
+ private:
+  sim::EvaluationSpec spec_;
+  std::vector<roi::Centre> centres_;
+  roi::CircularRoiSet circles_;
+  roi::RectangularRoiSet rects_;
+  roi::GridFilter<roi::CircularRoiSet> circle_grid_;
+  roi::GridFilter<roi::RectangularRoiSet> rect_grid_;
+  roi::IndexVector kept_;
+};
 
 // ---- Tables 9 and 11: keyframes --------------------------------------------------------------
 

@@ -8,7 +8,7 @@
 // Frames as everywhere in trajroi: the global frame is ENU about `origin` (x east, y north,
 // z up, the ground at z = 0); robot and sensor frames are REP-103; headings are
 // counter-clockwise from +x.
-#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -66,6 +66,8 @@ struct Mounting {
   double roll_rad = 0.0;
   double pitch_rad = 0.0;
   double yaw_rad = 0.0;
+  // robot_from_sensor = T(xyz) · Rz(yaw) · Ry(pitch) · Rx(roll).
+  [[nodiscard]] Eigen::Isometry3d robot_from_sensor() const;
 };
 
 struct RobotSpec {
@@ -117,6 +119,20 @@ struct ImuSpec {
   double heading_bias_deg = 0.0;    // constant error of the reported yaw
   double magnetic_declination_deg = 0.0;  // the VN-100 reports magnetic yaw
 };
+
+// Bytes on the wire of one GNSS epoch (NAV-HPPOSLLH 36 + 8, NAV-PVT 92 + 8) and of one
+// simulated VN-100 frame (sync, group, mask, TimeStartup 8, three 12-byte vectors, CRC).
+inline constexpr std::size_t kGnssEpochBytes = 144;
+inline constexpr std::size_t kImuFrameBytes = 50;
+
+// From a sample's time to the host's receipt of its last byte (latency plus transmission at
+// 10 bits a byte): the delay a consumer of the streams subtracts to stamp samples.
+[[nodiscard]] inline double gnss_delay_s(const GnssSpec& g) noexcept {
+  return g.latency_s + static_cast<double>(kGnssEpochBytes) * 10.0 / g.baud;
+}
+[[nodiscard]] inline double imu_delay_s(const ImuSpec& i) noexcept {
+  return i.latency_s + static_cast<double>(kImuFrameBytes) * 10.0 / i.baud;
+}
 
 struct Keyframe {
   std::string name;

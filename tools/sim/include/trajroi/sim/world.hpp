@@ -32,15 +32,14 @@ class World {
   struct BoxShape {
     double cx, cy, cos_yaw, sin_yaw, half_x, half_y, height;
     std::uint8_t reflectivity;
+    // Entry distance of a ray into the box, or +∞.
+    [[nodiscard]] double hit(const Eigen::Vector3d& o, const Eigen::Vector3d& d) const noexcept;
   };
   struct CylinderShape {
     double cx, cy, radius, height;
     std::uint8_t reflectivity;
+    [[nodiscard]] double hit(const Eigen::Vector3d& o, const Eigen::Vector3d& d) const noexcept;
   };
-  // Entry distance of the ray into one primitive, or +∞.
-  [[nodiscard]] double hit_box(const BoxShape& b, const Eigen::Vector3d& o, const Eigen::Vector3d& d) const noexcept;
-  [[nodiscard]] double hit_cylinder(const CylinderShape& c, const Eigen::Vector3d& o,
-                                    const Eigen::Vector3d& d) const noexcept;
 
   std::uint8_t ground_reflectivity_;
   std::vector<BoxShape> boxes_;
