@@ -70,6 +70,12 @@ void CircularRoiSet::assign(std::span<const Centre> centres) {
   }
 }
 
+void CircularRoiSet::assign(std::span<const Centre> centres, double radius_m) {
+  require_positive(radius_m, "circular ROI radius");
+  radius_m_ = radius_m;
+  assign(centres);
+}
+
 CellRelation CircularRoiSet::relation(std::size_t j, const Box& cell,
                                       double tolerance_m) const noexcept {
   if (std::sqrt(box_far_distance2(cell, cx_[j], cy_[j])) <= radius_m_ - tolerance_m) {
@@ -127,6 +133,14 @@ void RectangularRoiSet::assign(std::span<const Centre> centres) {
     rects_.push_back(
         make_rect_geometry(c.position.x(), c.position.y(), c.theta_rad, height_m_, width_m_));
   }
+}
+
+void RectangularRoiSet::assign(std::span<const Centre> centres, double height_m, double width_m) {
+  require_positive(height_m, "rectangular ROI height a");
+  require_positive(width_m, "rectangular ROI width b");
+  height_m_ = height_m;
+  width_m_ = width_m;
+  assign(centres);
 }
 
 Box RectangularRoiSet::bounds(std::size_t j) const noexcept {

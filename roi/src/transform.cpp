@@ -11,6 +11,22 @@ Eigen::Isometry3d pose_from_xy_yaw(double x_m, double y_m, double yaw_rad, doubl
   return pose;
 }
 
+Eigen::Isometry3d pose_from_xyz_rpy(const Eigen::Vector3d& xyz_m, double roll_rad, double pitch_rad, double yaw_rad) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = xyz_m;
+  t.linear() = (Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch_rad, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(roll_rad, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  return t;
+}
+
+Eigen::Isometry3d pose_from_position_quaternion(const Eigen::Vector3d& position_m, const Eigen::Quaterniond& orientation) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear() = orientation.toRotationMatrix();
+  t.translation() = position_m;
+  return t;
+}
+
 namespace {
 
 template <typename Point>

@@ -131,19 +131,27 @@ bool MapReader::boolean(std::string_view key, bool fallback) {
 }
 
 std::vector<double> MapReader::numbers(std::string_view key, std::size_t count) {
+  return number_list(key, count, count);
+}
+
+std::vector<double> MapReader::number_list(std::string_view key, std::size_t min_count, std::size_t max_count) {
   const YAML::Node list = node(key);
   if (!list) {
     missing(key);
   }
   state_->used.emplace(key);
-  if (!list.IsSequence() || list.size() != count) fail(key, "must be a list of " + std::to_string(count) + " numbers");
+  const std::string expected = min_count == max_count
+                                   ? "a list of " + std::to_string(min_count) + " finite numbers"
+                                   : "a list of " + std::to_string(min_count) + " to " + std::to_string(max_count) +
+                                         " finite numbers";
+  if (!list.IsSequence() || list.size() < min_count || list.size() > max_count) fail(key, "must be " + expected);
   std::vector<double> values;
   for (const auto& item : list) {
     double value = 0.0;
     const std::string text = item.IsScalar() ? item.Scalar() : std::string();
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
     if (!item.IsScalar() || ec != std::errc{} || end != text.data() + text.size() || !std::isfinite(value)) {
-      fail(key, "must be a list of " + std::to_string(count) + " finite numbers");
+      fail(key, "must be " + expected);
     }
     values.push_back(value);
   }

@@ -119,7 +119,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
         --frame_.lost_packets;
         --counters_.lost_packets;
       }
-      append_late(packet, anchor_time_ns_ + (unwrapped_toh_us_ + delta_us) * 1000);
+      append_late(packet, anchor_time_ns_ + (unwrapped_toh_us_ + delta_us) * 1000, sink);
       return;
     }
     const auto delta = static_cast<double>(delta_us);
@@ -191,6 +191,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
     frame_.end_time_ns = std::max(frame_.end_time_ns, t);
   }
   if (!counted) ++frame_.packets;
+  report_points(sink);
 }
 
 void StreamDecoder::decode_to_scratch(std::span<const std::uint8_t> packet) {
@@ -203,7 +204,15 @@ void StreamDecoder::decode_to_scratch(std::span<const std::uint8_t> packet) {
   counters_.merged_returns += r.merged_returns;
 }
 
-void StreamDecoder::append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns) {
+void StreamDecoder::report_points(FrameSink& sink) {
+  if (frame_.points.size() > reported_) {
+    const std::size_t first = reported_;
+    reported_ = frame_.points.size();
+    sink.on_points(frame_, first);
+  }
+}
+
+void StreamDecoder::append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns, FrameSink& sink) {
   if (frame_.points.empty() || packet_time_ns < frame_.start_time_ns) {
     ++counters_.late_dropped;
     return;
@@ -216,9 +225,12 @@ void StreamDecoder::append_late(std::span<const std::uint8_t> packet, std::int64
     placed.time_offset_ns = static_cast<std::uint32_t>(t - frame_.start_time_ns);
     frame_.end_time_ns = std::max(frame_.end_time_ns, t);
   }
+  report_points(sink);
 }
 
 void StreamDecoder::finish_frame(FrameSink& sink, bool partial) {
+  report_points(sink);
+  reported_ = 0;
   if (!frame_.points.empty() || frame_.packets > 0) {
     frame_.index = next_index_++;
     frame_.partial = partial || first_frame_;

@@ -4,9 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
-#include <sstream>
 #include <limits>
 #include <numbers>
+#include <sstream>
 #include <stdexcept>
 
 #include "trajroi/config/yaml_reader.hpp"
@@ -185,28 +185,21 @@ bool place_frame(const vlp16::Frame& frame, const pose::PoseBuffer& poses, const
                  PoseMode mode, std::vector<roi::PointXYZI>& out, pose::PoseStatus& status) {
   out.clear();
   out.reserve(frame.points.size());
-  std::int64_t pose_time = 0;
-  bool have_pose = false;
-  Eigen::Isometry3d global_from_lidar = Eigen::Isometry3d::Identity();
-  if (mode == PoseMode::kPerFrame) {
-    const pose::PoseQuery q = poses.pose_at(frame.start_time_ns + (frame.end_time_ns - frame.start_time_ns) / 2);
-    status = q.status;
-    if (!q.valid()) return false;
-    global_from_lidar = q.global_from_robot * robot_from_lidar;
+  // Per frame: one query at the frame's middle, a period longer than any frame.
+  const bool per_frame = mode == PoseMode::kPerFrame;
+  pose::FiringPoses firing(poses, robot_from_lidar,
+                           per_frame ? std::numeric_limits<std::int64_t>::max() : vlp16::kFiringCycle_ns);
+  const Eigen::Isometry3d* global_from_lidar = nullptr;
+  if (per_frame) {
+    global_from_lidar = firing.at(frame.start_time_ns + (frame.end_time_ns - frame.start_time_ns) / 2, status);
+    if (global_from_lidar == nullptr) return false;
   }
   for (const vlp16::Point& p : frame.points) {
-    if (mode == PoseMode::kPerFiring) {
-      const std::int64_t t = frame.start_time_ns + p.time_offset_ns;
-      if (!have_pose || t - pose_time >= vlp16::kFiringCycle_ns || t < pose_time) {
-        const pose::PoseQuery q = poses.pose_at(t);
-        status = q.status;
-        if (!q.valid()) return false;
-        global_from_lidar = q.global_from_robot * robot_from_lidar;
-        pose_time = t;
-        have_pose = true;
-      }
+    if (!per_frame) {
+      global_from_lidar = firing.at(frame.start_time_ns + p.time_offset_ns, status);
+      if (global_from_lidar == nullptr) return false;
     }
-    push_point(out, global_from_lidar * Eigen::Vector3d(p.x, p.y, p.z), static_cast<float>(p.intensity));
+    push_point(out, *global_from_lidar * Eigen::Vector3d(p.x, p.y, p.z), static_cast<float>(p.intensity));
   }
   status = pose::PoseStatus::kValid;
   return true;

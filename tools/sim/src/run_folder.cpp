@@ -1,6 +1,5 @@
 #include "trajroi/sim/run_folder.hpp"
 
-#include <pcap/pcap.h>
 
 #include <chrono>
 #include <cmath>
@@ -13,6 +12,7 @@
 
 #include "trajroi/framing/little_endian.hpp"
 #include "trajroi/serial/byte_log.hpp"
+#include "trajroi/vlp16/pcap_source.hpp"
 #include "trajroi/vlp16/packet_source.hpp"
 
 namespace trajroi::sim {
@@ -63,70 +63,6 @@ std::vector<std::uint8_t> read_all(const fs::path& file) {
   if (!in) throw std::runtime_error(file.string() + ": cannot be read");
   return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), {});
 }
-
-// Ethernet + IPv4 + UDP around a payload, as the sensor sends it (broadcast from the
-// factory address 192.168.1.201, Velodyne's OUI 60:76:88; UDP checksum 0, allowed on IPv4).
-class PcapWriter {
- public:
-  explicit PcapWriter(const fs::path& path) : path_(path) {
-    handle_ = pcap_open_dead_with_tstamp_precision(DLT_EN10MB, 65535, PCAP_TSTAMP_PRECISION_NANO);
-    if (handle_ == nullptr) throw std::runtime_error(path.string() + ": libpcap cannot open a writer");
-    dumper_ = pcap_dump_open(handle_, path.c_str());
-    if (dumper_ == nullptr) {
-      const std::string error = pcap_geterr(handle_);
-      pcap_close(handle_);
-      throw std::runtime_error(path.string() + ": cannot create: " + error);
-    }
-  }
-  ~PcapWriter() {
-    if (dumper_ != nullptr) pcap_dump_close(dumper_);
-    if (handle_ != nullptr) pcap_close(handle_);
-  }
-  PcapWriter(const PcapWriter&) = delete;
-  PcapWriter& operator=(const PcapWriter&) = delete;
-
-  void write(std::int64_t time_ns, std::uint16_t port, std::span<const std::uint8_t> payload) {
-    frame_.assign({0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0x60, 0x76, 0x88, 0x00, 0x00, 0x01, 0x08, 0x00});
-    const std::size_t ip_start = frame_.size();
-    const auto ip_length = static_cast<std::uint16_t>(20 + 8 + payload.size());
-    const std::uint8_t ip[20] = {0x45, 0, static_cast<std::uint8_t>(ip_length >> 8), static_cast<std::uint8_t>(ip_length),
-                                 static_cast<std::uint8_t>(id_ >> 8), static_cast<std::uint8_t>(id_), 0x40, 0, 64, 17, 0, 0,
-                                 192, 168, 1, 201, 255, 255, 255, 255};
-    ++id_;
-    frame_.insert(frame_.end(), std::begin(ip), std::end(ip));
-    std::uint32_t sum = 0;
-    for (std::size_t i = 0; i < 20; i += 2) sum += static_cast<std::uint32_t>(frame_[ip_start + i] << 8 | frame_[ip_start + i + 1]);
-    while (sum > 0xFFFF) sum = (sum & 0xFFFF) + (sum >> 16);
-    const auto checksum = static_cast<std::uint16_t>(~sum);
-    frame_[ip_start + 10] = static_cast<std::uint8_t>(checksum >> 8);
-    frame_[ip_start + 11] = static_cast<std::uint8_t>(checksum);
-    const auto udp_length = static_cast<std::uint16_t>(8 + payload.size());
-    const std::uint8_t udp[8] = {static_cast<std::uint8_t>(port >> 8), static_cast<std::uint8_t>(port),
-                                 static_cast<std::uint8_t>(port >> 8), static_cast<std::uint8_t>(port),
-                                 static_cast<std::uint8_t>(udp_length >> 8), static_cast<std::uint8_t>(udp_length), 0, 0};
-    frame_.insert(frame_.end(), std::begin(udp), std::end(udp));
-    frame_.insert(frame_.end(), payload.begin(), payload.end());
-    pcap_pkthdr header{};
-    header.ts.tv_sec = static_cast<time_t>(time_ns / 1'000'000'000);
-    header.ts.tv_usec = static_cast<suseconds_t>(time_ns % 1'000'000'000);  // ns: the file's precision
-    header.caplen = header.len = static_cast<bpf_u_int32>(frame_.size());
-    pcap_dump(reinterpret_cast<u_char*>(dumper_), &header, frame_.data());
-  }
-
-  void close() {
-    const bool failed = pcap_dump_flush(dumper_) != 0;
-    pcap_dump_close(dumper_);
-    dumper_ = nullptr;
-    if (failed) throw std::runtime_error(path_.string() + ": cannot write");
-  }
-
- private:
-  fs::path path_;
-  pcap_t* handle_ = nullptr;
-  pcap_dumper_t* dumper_ = nullptr;
-  std::vector<std::uint8_t> frame_;
-  std::uint16_t id_ = 0;
-};
 
 class FolderSink final : public SimulationSink {
  public:
@@ -190,7 +126,7 @@ class FolderSink final : public SimulationSink {
     labels_.write(header.data(), header.size());
   }
 
-  PcapWriter pcap_;
+  vlp16::PcapWriter pcap_;
   serial::RecordingWriter gnss_;
   serial::RecordingWriter imu_;
   BinaryFile poses_;
@@ -213,7 +149,7 @@ std::string daemon_config(const Scenario& s) {
   std::snprintf(
       text, sizeof text,
       "# trajroid configuration written by `trajroi sim` for scenario '%s'.\n"
-      "# Replays this folder: trajroid --config trajroid.yaml --replay .\n"
+      "# Replays this folder: trajroid --config <this folder>/trajroid.yaml --replay <this folder>\n"
       "# Relative paths are relative to this file.\n"
       "global_frame:\n"
       "  origin: {lat_deg: %.9f, lon_deg: %.9f, height_m: %.4f}\n"
@@ -222,16 +158,14 @@ std::string daemon_config(const Scenario& s) {
       "lidar:\n"
       "  model: VLP-16\n"
       "  mounting: {xyz: [%.4f, %.4f, %.4f], roll_deg: %.4f, pitch_deg: %.4f, yaw_deg: %.4f}\n"
+      "  min_range_m: %.3f\n"
       "  max_range_m: %.3f\n"
-      "  replay: %s\n"
       "gnss:\n"
       "  antenna: [%.4f, %.4f, %.4f]\n"
       "  delay_s: %.6f    # epoch → receipt of its NAV-PVT (latency + transmission)\n"
-      "  replay: %s\n"
       "imu:\n"
       "  magnetic_declination_deg: %.4f\n"
       "  delay_s: %.6f    # sample → receipt of its frame\n"
-      "  replay: %s\n"
       "roi:\n"
       "  shape: circular\n"
       "  circle_diameter_m: %.3f\n"
@@ -240,9 +174,9 @@ std::string daemon_config(const Scenario& s) {
       "  spacing_ratio: 0.25\n"
       "  look_ahead_m: %.3f\n",
       s.name.c_str(), s.origin.lat_deg, s.origin.lon_deg, s.origin.height_m, kTrajectoryFile, m.xyz_m.x(), m.xyz_m.y(),
-      m.xyz_m.z(), m.roll_rad * kRadToDeg, m.pitch_rad * kRadToDeg, m.yaw_rad * kRadToDeg, s.lidar.max_range_m,
-      kLidarFile, s.robot.gnss_antenna_m.x(), s.robot.gnss_antenna_m.y(), s.robot.gnss_antenna_m.z(), gnss_delay_s(s.gnss),
-      kGnssFile, s.imu.magnetic_declination_deg, imu_delay_s(s.imu), kImuFile, e.circle_diameter_m, e.rect_height_m,
+      m.xyz_m.z(), m.roll_rad * kRadToDeg, m.pitch_rad * kRadToDeg, m.yaw_rad * kRadToDeg, s.lidar.min_range_m,
+      s.lidar.max_range_m, s.robot.gnss_antenna_m.x(), s.robot.gnss_antenna_m.y(), s.robot.gnss_antenna_m.z(),
+      gnss_delay_s(s.gnss), s.imu.magnetic_declination_deg, imu_delay_s(s.imu), e.circle_diameter_m, e.rect_height_m,
       e.rect_width_m, e.look_ahead_m);
   return text;
 }

@@ -9,6 +9,7 @@
 
 #include "trajroi/config/yaml_reader.hpp"
 #include "trajroi/framing/utc.hpp"
+#include "trajroi/roi/transform.hpp"
 
 namespace trajroi::sim {
 namespace {
@@ -216,12 +217,7 @@ EvaluationSpec read_evaluation(MapReader e) {
 }  // namespace
 
 Eigen::Isometry3d Mounting::robot_from_sensor() const {
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.translation() = xyz_m;
-  t.linear() = (Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch_rad, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(roll_rad, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  return t;
+  return roi::pose_from_xyz_rpy(xyz_m, roll_rad, pitch_rad, yaw_rad);
 }
 
 bool parse_utc_iso8601(std::string_view text, std::int64_t& utc_ns) {

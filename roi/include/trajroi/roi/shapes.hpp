@@ -52,6 +52,8 @@ class CircularRoiSet {
   CircularRoiSet(double radius_m, std::span<const Centre> centres, ZLimits z = {});
   // Replaces the centres, reusing storage (no allocation once the capacity suffices).
   void assign(std::span<const Centre> centres);
+  // … and the radius (checked as in the constructor).
+  void assign(std::span<const Centre> centres, double radius_m);
 
   [[nodiscard]] std::size_t size() const noexcept { return cx_.size(); }
   [[nodiscard]] double radius_m() const noexcept { return radius_m_; }
@@ -107,6 +109,7 @@ class RectangularRoiSet {
   RectangularRoiSet(double height_m, double width_m, std::span<const Centre> centres,
                     ZLimits z = {});
   void assign(std::span<const Centre> centres);
+  void assign(std::span<const Centre> centres, double height_m, double width_m);
 
   [[nodiscard]] std::size_t size() const noexcept { return rects_.size(); }
   [[nodiscard]] double height_m() const noexcept { return height_m_; }

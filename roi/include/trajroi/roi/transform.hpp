@@ -15,6 +15,16 @@ namespace trajroi::roi {
 [[nodiscard]] Eigen::Isometry3d pose_from_xy_yaw(double x_m, double y_m, double yaw_rad,
                                                  double z_m = 0.0);
 
+// A sensor's mounting, a_from_b = T(xyz) · Rz(yaw) · Ry(pitch) · Rx(roll) (angles in rad).
+[[nodiscard]] Eigen::Isometry3d pose_from_xyz_rpy(const Eigen::Vector3d& xyz_m, double roll_rad, double pitch_rad,
+                                                  double yaw_rad);
+
+// A pose given as a translation and a unit quaternion (w, x, y, z), rebuilt always the same
+// way (Quaterniond::toRotationMatrix, no renormalisation), so two programs that exchange these
+// seven numbers transform points bit-identically.
+[[nodiscard]] Eigen::Isometry3d pose_from_position_quaternion(const Eigen::Vector3d& position_m,
+                                                              const Eigen::Quaterniond& orientation);
+
 // out[i] = target_from_source · in[i] for every point, computed in double and stored in the
 // output's precision; intensity is copied. `in` and `out` must have the same size and may be
 // the same array (in-place). Allocates nothing.

@@ -50,6 +50,8 @@ class MapReader {
   // A fixed-size list of numbers, e.g. `xyz: [0, 0, 1.2]`.
   [[nodiscard]] std::vector<double> numbers(std::string_view key, std::size_t count);
   [[nodiscard]] std::vector<double> numbers(std::string_view key, std::vector<double> fallback);
+  // A list of min_count … max_count numbers (required).
+  [[nodiscard]] std::vector<double> number_list(std::string_view key, std::size_t min_count, std::size_t max_count);
   // One of `choices`.
   [[nodiscard]] std::string choice(std::string_view key, std::initializer_list<std::string_view> choices,
                                    std::string_view fallback);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -55,6 +56,30 @@ class PcapSource final : public PacketSource {
   std::chrono::steady_clock::time_point first_delivery_;
   bool pending_ = false;  // a datagram read but not yet due
   Datagram pending_datagram_;
+};
+
+// Writes UDP payloads to a pcap file (nanosecond timestamps), wrapped in Ethernet + IPv4 +
+// UDP headers as the sensor sends them: broadcast from the factory address 192.168.1.201,
+// Velodyne's OUI 60:76:88, UDP checksum 0 (allowed on IPv4). Throws std::runtime_error naming
+// the file when it cannot be created or written.
+class PcapWriter {
+ public:
+  explicit PcapWriter(const std::filesystem::path& path);
+  ~PcapWriter();
+  PcapWriter(const PcapWriter&) = delete;
+  PcapWriter& operator=(const PcapWriter&) = delete;
+
+  void write(std::int64_t time_ns, std::uint16_t port, std::span<const std::uint8_t> payload);
+  void flush();
+  // Flushes and closes; throws when the data could not be written.
+  void close();
+
+ private:
+  struct Handle;
+  std::unique_ptr<Handle> handle_;
+  std::filesystem::path path_;
+  std::vector<std::uint8_t> frame_;
+  std::uint16_t id_ = 0;
 };
 
 }  // namespace trajroi::vlp16

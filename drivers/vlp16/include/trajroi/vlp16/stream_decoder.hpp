@@ -17,6 +17,7 @@
 // order and joins the current frame if it falls inside it; a repeated timestamp is a
 // duplicate and dropped.
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -61,6 +62,14 @@ class FrameSink {
   virtual ~FrameSink() = default;
   // The frame is valid during the call only; its storage is reused.
   virtual void on_frame(const Frame& frame) = 0;
+  // Points were appended to the frame in progress: frame.points[first …] are new (their
+  // time offsets final). Called after every packet that added points, and before on_frame
+  // for the points not yet reported, so a sink can process a sweep packet by packet and
+  // only close it in on_frame. `frame.index` is not yet set.
+  virtual void on_points(const Frame& frame, std::size_t first) {
+    (void)frame;
+    (void)first;
+  }
 };
 
 struct StreamCounters {
@@ -110,9 +119,10 @@ class StreamDecoder {
  private:
   void accept(std::span<const std::uint8_t> packet, std::int64_t receive_time_ns, FrameSink& sink);
   void decode_to_scratch(std::span<const std::uint8_t> packet);  // and count what it held
-  void append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns);
+  void append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns, FrameSink& sink);
   std::int64_t packet_time_ns(std::uint32_t toh_us, std::int64_t receive_time_ns, double period_us);
   void finish_frame(FrameSink& sink, bool partial);
+  void report_points(FrameSink& sink);
 
   PacketDecoder decoder_;
   StreamOptions options_;
@@ -138,6 +148,7 @@ class StreamDecoder {
   bool have_phase_ = false;
 
   Frame frame_;
+  std::size_t reported_ = 0;  // points of frame_ handed to on_points
   bool first_frame_ = true;
   std::uint64_t next_index_ = 0;
   std::vector<Point> scratch_;

@@ -92,6 +92,8 @@ class PoseBuffer {
 
   [[nodiscard]] const PoseBufferCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const PoseGate& gate() const noexcept { return gate_; }
+  // The newest fix, or nullptr before the first.
+  [[nodiscard]] const GnssFix* newest_fix() const noexcept { return fixes_.size > 0 ? &fixes_.newest() : nullptr; }
 
  private:
   template <class T>
@@ -113,6 +115,46 @@ class PoseBuffer {
   Ring<GnssFix> fixes_;
   Ring<AttitudeSample> attitudes_;
   PoseBufferCounters counters_;
+};
+
+}  // namespace trajroi::pose
+
+namespace trajroi::pose {
+
+// The sensor's pose for each firing of a sweep, queried once per firing period (a VLP-16
+// firing sequence, 55.296 µs) as the points come in time order: every point of one firing
+// gets the same global_from_sensor, so motion is compensated per firing, not per point.
+class FiringPoses {
+ public:
+  FiringPoses(const PoseBuffer& buffer, const Eigen::Isometry3d& robot_from_sensor, std::int64_t period_ns) noexcept
+      : buffer_(&buffer), robot_from_sensor_(robot_from_sensor), period_ns_(period_ns) {}
+
+  // global_from_sensor at t, or nullptr when the pose is not valid (`status` says why). A new
+  // query is made when t leaves [t_query, t_query + period); generation() then grows.
+  [[nodiscard]] const Eigen::Isometry3d* at(std::int64_t t_ns, PoseStatus& status) noexcept {
+    if (!have_ || t_ns < query_ns_ || t_ns - query_ns_ >= period_ns_) {
+      const PoseQuery q = buffer_->pose_at(t_ns);
+      status_ = q.status;
+      have_ = true;
+      query_ns_ = t_ns;
+      ++generation_;
+      if (q.valid()) global_from_sensor_ = q.global_from_robot * robot_from_sensor_;
+    }
+    status = status_;
+    return status_ == PoseStatus::kValid ? &global_from_sensor_ : nullptr;
+  }
+  [[nodiscard]] std::uint64_t generation() const noexcept { return generation_; }
+  void reset() noexcept { have_ = false; }
+
+ private:
+  const PoseBuffer* buffer_;
+  Eigen::Isometry3d robot_from_sensor_;
+  std::int64_t period_ns_;
+  bool have_ = false;
+  std::int64_t query_ns_ = 0;
+  std::uint64_t generation_ = 0;
+  PoseStatus status_ = PoseStatus::kNoGnss;
+  Eigen::Isometry3d global_from_sensor_ = Eigen::Isometry3d::Identity();
 };
 
 }  // namespace trajroi::pose

@@ -1,0 +1,113 @@
+#pragma once
+
+// trajroid's configuration, read strictly from YAML (config/trajroid.yaml documents every
+// key). Relative paths are resolved against the configuration file's folder. Every problem
+// throws config::ConfigError naming the file, line, key and value.
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "trajroi/config/yaml_reader.hpp"
+#include "trajroi/pose/geodetic.hpp"
+#include "trajroi/pose/pose_buffer.hpp"
+
+namespace trajroi::daemon {
+
+// Exit code for a configuration error (sysexits.h EX_CONFIG); systemd does not restart it.
+inline constexpr int kExitConfig = 78;
+
+enum class RoiShape : std::uint8_t { kCircular, kRectangular };
+enum class PoseMode : std::uint8_t { kPerFiring, kPerSweep };
+enum class SchedPolicy : std::uint8_t { kOther, kFifo, kRr };
+
+struct ThreadConfig {
+  SchedPolicy policy = SchedPolicy::kOther;
+  int priority = 0;        // 1 … 99 for fifo / rr
+  std::vector<int> cpus;   // affinity; empty: any
+};
+
+struct DaemonConfig {
+  std::filesystem::path file;  // where it was read from
+
+  pose::Geodetic origin;
+
+  std::filesystem::path trajectory_file;  // CSV of x,y (global frame, m)
+
+  struct Lidar {
+    std::filesystem::path calibration;  // velodyne/nebula YAML; empty: the manual's values
+    Eigen::Isometry3d robot_from_lidar = Eigen::Isometry3d::Identity();
+    double min_range_m = 0.0;
+    double max_range_m = 130.0;
+    double cut_azimuth_deg = 0.0;
+    std::string bind_address = "0.0.0.0";
+    std::uint16_t data_port = 2368;
+    std::uint16_t position_port = 8308;
+    int receive_buffer_bytes = 4 << 20;
+  } lidar;
+
+  struct Serial {
+    std::string device;  // empty: this stream is not used live
+    int baud = 115200;
+    double delay_s = 0.0;
+  };
+  Serial gnss;
+  Eigen::Vector3d gnss_antenna_m = Eigen::Vector3d::Zero();  // in the robot frame
+  Serial imu;
+  double magnetic_declination_deg = 0.0;
+  Eigen::Quaterniond robot_from_imu = Eigen::Quaterniond::Identity();
+
+  PoseMode pose_mode = PoseMode::kPerFiring;
+  pose::PoseGate gate;
+  std::size_t pose_capacity = 4096;
+
+  struct Roi {
+    RoiShape shape = RoiShape::kCircular;
+    double circle_diameter_m = 28.0;
+    double rect_height_m = 12.0;
+    double rect_width_m = 28.0;
+    double spacing_ratio = 0.25;
+    double look_ahead_m = 42.0;
+    double z_min_m = -std::numeric_limits<double>::infinity();
+    double z_max_m = std::numeric_limits<double>::infinity();
+    double look_ahead_per_mps_s = 0.0;  // look-ahead grows by speed × this
+    double width_per_mps_s = 0.0;       // diameter / rectangle width grows by speed × this
+    double max_speed_mps = 5.0;         // speed used for the growth is capped here
+  } roi;
+
+  struct Lcm {
+    std::string url = "udpm://239.255.76.67:7667?ttl=0";
+    std::string points = "TRAJROI_POINTS";
+    std::string pose = "TRAJROI_POSE";
+    std::string roi = "TRAJROI_ROI";
+    std::string status = "TRAJROI_STATUS";
+    std::string trajectory = "TRAJROI_TRAJECTORY";
+  } lcm;
+
+  struct Buffers {
+    std::size_t lidar_packets = 4096;    // ≈ 2.7 s of dual-return packets
+    std::size_t serial_chunks = 1024;
+    std::size_t sweeps = 8;
+    std::size_t max_points_per_sweep = 131072;  // a 5 Hz dual-return sweep is ≈ 115 000
+  } buffers;
+
+  struct Logging {
+    std::string level = "info";           // trace debug info warn error critical off
+    double warning_interval_s = 5.0;      // per-packet warnings: at most one per interval and kind
+  } logging;
+
+  struct Realtime {
+    bool lock_memory = false;  // mlockall(MCL_CURRENT | MCL_FUTURE)
+    ThreadConfig lidar, gnss, imu, processing, publisher;
+  } realtime;
+};
+
+// Reads and checks a configuration. Throws config::ConfigError.
+[[nodiscard]] DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::path& file);
+[[nodiscard]] DaemonConfig load_daemon_config(const std::filesystem::path& file);
+
+}  // namespace trajroi::daemon

@@ -1,0 +1,60 @@
+#pragma once
+
+// Between the daemon's values and its LCM messages (transport/lcmtypes): filling the outgoing
+// messages from a Sweep (reusing their vectors), and checking an incoming trajectory.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "trajroi/daemon/config.hpp"
+#include "trajroi/daemon/sweep_processor.hpp"
+#include "trajroi/pose/geodetic.hpp"
+#include "trajroi/points_t.hpp"
+#include "trajroi/pose_t.hpp"
+#include "trajroi/roi_t.hpp"
+#include "trajroi/trajectory_t.hpp"
+
+namespace trajroi::daemon {
+
+void fill_pose(const Sweep& sweep, trajroi::pose_t& out);
+void fill_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& out);
+void fill_roi(const Sweep& sweep, trajroi::roi_t& out);
+
+// Why an incoming trajectory was refused (counted by reason in status_t).
+enum class TrajectoryReject : std::uint8_t {
+  kNone,
+  kBadId,            // id ≤ 0
+  kBadCoordinates,   // neither GLOBAL_XY nor LAT_LON
+  kTooFewWaypoints,  // fewer than 2 (or fewer than 2 distinct)
+  kTooManyWaypoints,
+  kNonFinite,
+  kOutOfRange,       // latitude beyond ±90°, longitude beyond ±180°
+  kUndecodable,      // bytes that are not a trajectory_t
+};
+inline constexpr std::size_t kTrajectoryRejectCount = 8;
+[[nodiscard]] std::string_view to_string(TrajectoryReject reason) noexcept;
+
+struct TrajectoryCheck {
+  std::unique_ptr<ActiveTrajectory> trajectory;  // set when accepted
+  TrajectoryReject reason = TrajectoryReject::kNone;
+  std::string detail;  // for the log
+};
+
+inline constexpr std::int32_t kMaxMessageWaypoints = 100'000;
+
+[[nodiscard]] TrajectoryCheck check_trajectory(const trajroi::trajectory_t& message, const pose::GlobalFrame& frame);
+
+}  // namespace trajroi::daemon
+
+namespace trajroi::daemon {
+
+// Checks the size fields of an encoded trajectory_t before decoding it, so a hostile length
+// cannot make the decoder allocate gigabytes: kNone when decoding is safe.
+[[nodiscard]] TrajectoryReject precheck_trajectory_bytes(const void* data, std::size_t size) noexcept;
+
+// Decodes and checks an encoded trajectory_t (never throws).
+[[nodiscard]] TrajectoryCheck decode_trajectory(const void* data, std::size_t size, const pose::GlobalFrame& frame);
+
+}  // namespace trajroi::daemon

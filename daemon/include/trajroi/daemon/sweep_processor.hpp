@@ -1,0 +1,178 @@
+#pragma once
+
+// The processing thread's work, without the thread: lidar datagrams and GNSS / IMU bytes in
+// (each with its host receive time), filtered sweeps out. Pure and deterministic: the same
+// inputs in the same order give the same sweeps, which is what makes a replay exact and what
+// the tests drive directly.
+//
+// Per packet, as it arrives: decode (vlp16::StreamDecoder) → the sensor's pose at each
+// firing's time (pose::FiringPoses, or one pose for the sweep) → transform into the global
+// frame → ROI membership (roi::GridFilter, exact) → append the kept points to the sweep. At a
+// sweep's first packet the ROI chain is placed: centres every d from the robot's projection
+// on the active trajectory over the look-ahead (growing with speed when configured); a new
+// trajectory offered in between is swapped in there, never inside a sweep. At the sweep's
+// end the sweep goes to the SweepSink.
+//
+// No allocation once warm: every buffer is sized at construction (points per sweep up to
+// buffers.max_points_per_sweep; more are counted as truncated) and reused.
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "trajroi/daemon/config.hpp"
+#include "trajroi/pose/pose_buffer.hpp"
+#include "trajroi/pose_input/pose_input.hpp"
+#include "trajroi/roi/centres.hpp"
+#include "trajroi/roi/grid_filter.hpp"
+#include "trajroi/roi/point.hpp"
+#include "trajroi/roi/shapes.hpp"
+#include "trajroi/roi/trajectory.hpp"
+#include "trajroi/vlp16/stream_decoder.hpp"
+
+namespace trajroi::daemon {
+
+// A trajectory with the id it is published under (0: the configured file's).
+struct ActiveTrajectory {
+  roi::Trajectory trajectory;
+  std::int32_t id = 0;
+};
+
+// Sensor or robot pose as published: translation and unit quaternion (w, x, y, z). The
+// isometry the daemon computes with is rebuilt from exactly these numbers, so a consumer that
+// rebuilds it the same way (Quaterniond(w, x, y, z).toRotationMatrix()) transforms
+// bit-identically.
+struct PublishedPose {
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  [[nodiscard]] static PublishedPose from(const Eigen::Isometry3d& pose);
+  [[nodiscard]] Eigen::Isometry3d isometry() const;
+};
+
+struct Sweep {
+  std::uint64_t index = 0;
+  std::int64_t start_ns = 0;
+  std::int64_t end_ns = 0;
+  bool partial = false;
+  std::uint8_t return_mode = 0;
+  std::uint32_t points_in = 0;
+  std::uint32_t lost_packets = 0;
+  std::uint32_t truncated = 0;  // kept points beyond the buffer
+
+  // The pose: `filtered` only when it was valid for every point.
+  bool filtered = false;
+  pose::PoseStatus pose_status = pose::PoseStatus::kNoGnss;
+  std::int64_t pose_t_ns = 0;           // sweep start
+  PublishedPose robot;                  // global_from_robot at the start
+  PublishedPose sensor;                 // global_from_lidar at the start (used for the whole
+                                        // sweep in per-sweep mode)
+  double speed_mps = 0.0;
+  pose::FixQuality fix;                 // newest fix at the sweep's start
+  std::int64_t fix_t_ns = 0;            // its time (0: none)
+
+  // The ROI chain.
+  std::int32_t trajectory_id = 0;
+  RoiShape shape = RoiShape::kCircular;
+  double radius_m = 0.0, height_m = 0.0, width_m = 0.0, spacing_m = 0.0;
+  double start_s_m = 0.0, look_ahead_m = 0.0;
+  std::vector<roi::Centre> centres;
+
+  // Kept points, global frame, structure of arrays.
+  std::vector<float> x, y, z;
+  std::vector<std::uint8_t> intensity, ring, return_type;
+  std::vector<std::int32_t> time_offset_ns;
+
+  // Steady-clock bookkeeping: when the last datagram with points of this sweep arrived (set
+  // from set_input_arrival), and the processing time the wiring measured.
+  std::int64_t last_packet_arrival_ns = 0;
+  std::int64_t processing_ns = 0;
+
+  void reserve(std::size_t points, std::size_t centres);
+  void clear_points() noexcept;
+  [[nodiscard]] std::size_t size() const noexcept { return x.size(); }
+};
+
+enum class LidarPort : std::uint8_t { kData, kPosition };
+
+class SweepSink {
+ public:
+  virtual ~SweepSink() = default;
+  // `sweep` is valid during the call only.
+  virtual void on_sweep(const Sweep& sweep) = 0;
+};
+
+struct ProcessorCounters {
+  std::uint64_t sweeps = 0;
+  std::uint64_t sweeps_filtered = 0;
+  std::uint64_t sweeps_without_pose = 0;
+  std::uint64_t points_in = 0;
+  std::uint64_t points_kept = 0;
+  std::uint64_t points_truncated = 0;
+  std::uint64_t trajectory_swaps = 0;
+};
+
+class SweepProcessor {
+ public:
+  SweepProcessor(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> trajectory);
+  ~SweepProcessor();
+
+  void lidar_datagram(LidarPort port, std::span<const std::uint8_t> payload, std::int64_t receive_ns,
+                      SweepSink& sink);
+  void gnss_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) { pose_input_.gnss_bytes(bytes, receive_ns); }
+  void imu_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) { pose_input_.imu_bytes(bytes, receive_ns); }
+  // Steady-clock time the next datagram entered the daemon: a sweep keeps that of the last
+  // datagram that gave it points (for the latency figures; no effect on the output).
+  void set_input_arrival(std::int64_t steady_ns) noexcept { arrival_ns_ = steady_ns; }
+  // Ends the stream: the sweep in progress goes out (partial).
+  void flush(SweepSink& sink);
+
+  // A new trajectory, taking effect at the next sweep's start. One offered before the
+  // previous one took effect replaces it (that one is handed back by take_retired()).
+  void offer_trajectory(std::unique_ptr<ActiveTrajectory> trajectory);
+  // A trajectory no longer used, for the caller to free outside the real-time path.
+  [[nodiscard]] std::unique_ptr<ActiveTrajectory> take_retired() noexcept;
+  [[nodiscard]] std::int32_t active_trajectory_id() const noexcept { return active_->id; }
+
+  [[nodiscard]] const ProcessorCounters& counters() const noexcept { return counters_; }
+  [[nodiscard]] const vlp16::StreamCounters& lidar_counters() const noexcept { return decoder_.counters(); }
+  [[nodiscard]] const pose_input::PoseInput& pose_input() const noexcept { return pose_input_; }
+  [[nodiscard]] const pose::PoseBuffer& poses() const noexcept { return poses_; }
+  // The sweep being built (its pose status tells why a sweep is withheld).
+  [[nodiscard]] const Sweep& current() const noexcept { return sweep_; }
+
+ private:
+  class FrameAdapter;
+  void start_sweep(const vlp16::Frame& frame);
+  void add_points(const vlp16::Frame& frame, std::size_t first);
+  void end_sweep(const vlp16::Frame& frame, SweepSink& sink);
+  void filter_run(const vlp16::Frame& frame, std::size_t first, std::size_t end, const Eigen::Isometry3d& global_from_lidar);
+
+  DaemonConfig config_;
+  vlp16::StreamDecoder decoder_;
+  pose::PoseBuffer poses_;
+  pose_input::PoseInput pose_input_;
+  pose::FiringPoses firing_;
+
+  std::unique_ptr<ActiveTrajectory> active_;
+  std::unique_ptr<ActiveTrajectory> pending_;
+  std::unique_ptr<ActiveTrajectory> retired_;
+  double s_hint_m_ = 0.0;
+  bool have_hint_ = false;
+
+  roi::CircularRoiSet circles_;
+  roi::RectangularRoiSet rects_;
+  roi::GridFilter<roi::CircularRoiSet> circle_grid_;
+  roi::GridFilter<roi::RectangularRoiSet> rect_grid_;
+
+  Sweep sweep_;
+  bool in_sweep_ = false;
+  Eigen::Isometry3d sweep_sensor_pose_ = Eigen::Isometry3d::Identity();
+  std::vector<roi::PointXYZI> scratch_;  // one packet's points in the global frame
+  roi::IndexVector kept_;
+  std::int64_t arrival_ns_ = 0;
+  ProcessorCounters counters_;
+};
+
+}  // namespace trajroi::daemon

@@ -1,0 +1,68 @@
+// trajroid — the trajectory-ROI daemon. See daemon/README.md and config/trajroid.yaml.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+#include <optional>
+#include <string>
+
+#include "log.hpp"
+#include "trajroid.hpp"
+
+int main(int argc, char** argv) {
+  using namespace trajroi::daemon;
+  CLI::App app{"trajroid: VLP-16 + u-blox + VN-100 in, trajectory-ROI-filtered points out over LCM"};
+  std::string config_file;
+  std::string replay, record, rate = "max", lcm_url;
+  bool check_config = false;
+  app.add_option("--config", config_file, "YAML configuration (see config/trajroid.yaml)")->required();
+  app.add_option("--replay", replay, "Replay a run folder (lidar.pcap, gnss.trjb, imu.trjb) instead of the sensors");
+  app.add_option("--rate", rate, "Replay pace: realtime, max, or a factor of real time (e.g. 10)")->capture_default_str();
+  app.add_option("--record", record, "Record every raw input with its host receive time into this folder");
+  app.add_option("--lcm-url", lcm_url, "LCM provider URL (overrides lcm.url)");
+  app.add_flag("--check-config", check_config, "Check the configuration, print a summary and exit");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+
+  DaemonConfig config;
+  try {
+    config = load_daemon_config(config_file);
+  } catch (const trajroi::config::ConfigError& e) {
+    std::fprintf(stderr, "trajroid: configuration error: %s\n", e.what());
+    return kExitConfig;
+  }
+  RunOptions options;
+  if (!replay.empty()) options.replay = replay;
+  if (!record.empty()) options.record = record;
+  options.lcm_url = lcm_url;
+  if (rate == "max") {
+    options.rate = 0.0;
+  } else if (rate == "realtime") {
+    options.rate = 1.0;
+  } else {
+    try {
+      std::size_t used = 0;
+      options.rate = std::stod(rate, &used);
+      if (used != rate.size() || !(options.rate > 0.0) || options.rate > 1e6) throw std::invalid_argument(rate);
+    } catch (const std::exception&) {
+      std::fprintf(stderr, "trajroid: --rate: expected realtime, max or a factor > 0, got '%s'\n", rate.c_str());
+      return kExitConfig;
+    }
+  }
+  if (check_config) {
+    std::printf("%s: configuration OK (trajectory %s, ROI %s, pose %s, LCM %s)\n", config_file.c_str(),
+                config.trajectory_file.c_str(), config.roi.shape == RoiShape::kCircular ? "circular" : "rectangular",
+                config.pose_mode == PoseMode::kPerFiring ? "per firing" : "per sweep", config.lcm.url.c_str());
+    return 0;
+  }
+  log::init(config.logging.level);
+  try {
+    return run_daemon(config, options);
+  } catch (const std::exception& e) {
+    log::critical("fatal: {}", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,182 @@
+#include "trajroi/daemon/messages.hpp"
+
+#include <cmath>
+#include <vector>
+
+#include "trajroi/pose/attitude.hpp"
+
+namespace trajroi::daemon {
+namespace {
+
+template <typename T>
+void copy_into(std::vector<T>& out, const std::vector<T>& in) {
+  out.assign(in.begin(), in.end());
+}
+
+void set_pose(const PublishedPose& p, double (&position)[3], double (&orientation)[4]) {
+  for (int i = 0; i < 3; ++i) position[i] = p.position_m[i];
+  orientation[0] = p.orientation.w();
+  orientation[1] = p.orientation.x();
+  orientation[2] = p.orientation.y();
+  orientation[3] = p.orientation.z();
+}
+
+}  // namespace
+
+void fill_pose(const Sweep& sweep, trajroi::pose_t& out) {
+  out.t_ns = sweep.pose_t_ns;
+  out.sweep_index = static_cast<std::int64_t>(sweep.index);
+  out.valid = sweep.pose_status == pose::PoseStatus::kValid;
+  out.status = static_cast<std::int8_t>(sweep.pose_status);
+  out.status_text = std::string(pose::to_string(sweep.pose_status));
+  set_pose(sweep.robot, out.position_m, out.orientation);
+  out.yaw_rad = out.valid ? pose::roll_pitch_yaw(sweep.robot.orientation).yaw_rad : 0.0;
+  out.speed_mps = sweep.speed_mps;
+  out.fix_type = static_cast<std::int8_t>(sweep.fix.fix_type);
+  out.rtk_fixed = sweep.fix.rtk_fixed;
+  out.h_acc_m = sweep.fix.h_acc_m;
+}
+
+void fill_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& out) {
+  out.sweep_index = static_cast<std::int64_t>(sweep.index);
+  out.sweep_start_ns = sweep.start_ns;
+  out.sweep_end_ns = sweep.end_ns;
+  out.trajectory_id = sweep.trajectory_id;
+  out.pose_mode = mode == PoseMode::kPerSweep ? trajroi::points_t::POSE_PER_SWEEP : trajroi::points_t::POSE_PER_FIRING;
+  out.return_mode = static_cast<std::int8_t>(sweep.return_mode);
+  out.partial = sweep.partial;
+  out.points_in = static_cast<std::int32_t>(sweep.points_in);
+  out.lost_packets = static_cast<std::int32_t>(sweep.lost_packets);
+  fill_pose(sweep, out.pose);
+  set_pose(sweep.sensor, out.sensor_position_m, out.sensor_orientation);
+  out.num_points = static_cast<std::int32_t>(sweep.size());
+  copy_into(out.x, sweep.x);
+  copy_into(out.y, sweep.y);
+  copy_into(out.z, sweep.z);
+  copy_into(out.intensity, sweep.intensity);
+  copy_into(out.ring, sweep.ring);
+  copy_into(out.return_type, sweep.return_type);
+  copy_into(out.time_offset_ns, sweep.time_offset_ns);
+}
+
+void fill_roi(const Sweep& sweep, trajroi::roi_t& out) {
+  out.sweep_index = static_cast<std::int64_t>(sweep.index);
+  out.t_ns = sweep.start_ns;
+  out.trajectory_id = sweep.trajectory_id;
+  out.shape = sweep.shape == RoiShape::kCircular ? trajroi::roi_t::CIRCULAR : trajroi::roi_t::RECTANGULAR;
+  out.radius_m = sweep.radius_m;
+  out.height_m = sweep.height_m;
+  out.width_m = sweep.width_m;
+  out.spacing_m = sweep.spacing_m;
+  out.start_s_m = sweep.start_s_m;
+  out.look_ahead_m = sweep.look_ahead_m;
+  const std::size_t n = sweep.centres.size();
+  out.num_centres = static_cast<std::int32_t>(n);
+  out.cx.resize(n);
+  out.cy.resize(n);
+  out.theta_rad.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    out.cx[i] = sweep.centres[i].position.x();
+    out.cy[i] = sweep.centres[i].position.y();
+    out.theta_rad[i] = sweep.centres[i].theta_rad;
+  }
+}
+
+std::string_view to_string(TrajectoryReject reason) noexcept {
+  switch (reason) {
+    case TrajectoryReject::kNone: return "accepted";
+    case TrajectoryReject::kBadId: return "id not positive";
+    case TrajectoryReject::kBadCoordinates: return "unknown coordinates";
+    case TrajectoryReject::kTooFewWaypoints: return "fewer than 2 distinct waypoints";
+    case TrajectoryReject::kTooManyWaypoints: return "too many waypoints";
+    case TrajectoryReject::kNonFinite: return "non-finite waypoint";
+    case TrajectoryReject::kOutOfRange: return "latitude/longitude out of range";
+    case TrajectoryReject::kUndecodable: return "undecodable message";
+  }
+  return "unknown";
+}
+
+TrajectoryCheck check_trajectory(const trajroi::trajectory_t& m, const pose::GlobalFrame& frame) {
+  TrajectoryCheck r;
+  const auto reject = [&r](TrajectoryReject reason, std::string detail) {
+    r.reason = reason;
+    r.detail = std::move(detail);
+    return std::move(r);
+  };
+  if (m.id <= 0) return reject(TrajectoryReject::kBadId, "id " + std::to_string(m.id));
+  if (m.coordinates != trajroi::trajectory_t::GLOBAL_XY && m.coordinates != trajroi::trajectory_t::LAT_LON) {
+    return reject(TrajectoryReject::kBadCoordinates, "coordinates " + std::to_string(m.coordinates));
+  }
+  if (m.num_waypoints < 2) return reject(TrajectoryReject::kTooFewWaypoints, std::to_string(m.num_waypoints) + " waypoints");
+  if (m.num_waypoints > kMaxMessageWaypoints) {
+    return reject(TrajectoryReject::kTooManyWaypoints, std::to_string(m.num_waypoints) + " waypoints");
+  }
+  std::vector<Eigen::Vector2d> points;
+  points.reserve(static_cast<std::size_t>(m.num_waypoints));
+  for (std::size_t i = 0; i < static_cast<std::size_t>(m.num_waypoints); ++i) {
+    const double u = m.u[i];
+    const double v = m.v[i];
+    if (!std::isfinite(u) || !std::isfinite(v)) {
+      return reject(TrajectoryReject::kNonFinite, "waypoint " + std::to_string(i));
+    }
+    if (m.coordinates == trajroi::trajectory_t::GLOBAL_XY) {
+      points.emplace_back(u, v);
+      continue;
+    }
+    if (std::abs(u) > 90.0 || std::abs(v) > 180.0) {
+      return reject(TrajectoryReject::kOutOfRange, "waypoint " + std::to_string(i));
+    }
+    try {
+      points.push_back(frame.to_global(pose::Geodetic{u, v, 0.0}).head<2>());
+    } catch (const std::exception& e) {
+      return reject(TrajectoryReject::kOutOfRange, "waypoint " + std::to_string(i) + ": " + e.what());
+    }
+  }
+  try {
+    r.trajectory = std::make_unique<ActiveTrajectory>(ActiveTrajectory{roi::Trajectory(std::move(points)), m.id});
+  } catch (const roi::TrajectoryError& e) {
+    return reject(TrajectoryReject::kTooFewWaypoints, e.what());
+  }
+  return r;
+}
+
+}  // namespace trajroi::daemon
+
+namespace trajroi::daemon {
+
+TrajectoryReject precheck_trajectory_bytes(const void* data, std::size_t size) noexcept {
+  // hash (8) · id (4) · coordinates (1) · num_waypoints (4, big-endian) · u[n] · v[n]
+  constexpr std::size_t kHeader = 8 + 4 + 1 + 4;
+  if (size < kHeader) return TrajectoryReject::kUndecodable;
+  const auto* b = static_cast<const std::uint8_t*>(data);
+  const auto n = static_cast<std::int32_t>(std::uint32_t{b[13]} << 24 | std::uint32_t{b[14]} << 16 |
+                                           std::uint32_t{b[15]} << 8 | std::uint32_t{b[16]});
+  if (n < 0) return TrajectoryReject::kUndecodable;
+  if (n > kMaxMessageWaypoints) return TrajectoryReject::kTooManyWaypoints;
+  if (size < kHeader + 16 * static_cast<std::size_t>(n)) return TrajectoryReject::kUndecodable;
+  return TrajectoryReject::kNone;
+}
+
+TrajectoryCheck decode_trajectory(const void* data, std::size_t size, const pose::GlobalFrame& frame) {
+  TrajectoryCheck r;
+  r.reason = precheck_trajectory_bytes(data, size);
+  if (r.reason != TrajectoryReject::kNone) {
+    r.detail = std::to_string(size) + " bytes";
+    return r;
+  }
+  try {
+    trajroi::trajectory_t m;
+    if (m.decode(data, 0, static_cast<int>(size)) < 0) {
+      r.reason = TrajectoryReject::kUndecodable;
+      r.detail = "bad fingerprint or length";
+      return r;
+    }
+    return check_trajectory(m, frame);
+  } catch (const std::exception& e) {
+    r.reason = TrajectoryReject::kUndecodable;
+    r.detail = e.what();
+    return r;
+  }
+}
+
+}  // namespace trajroi::daemon

@@ -1,0 +1,302 @@
+#include "trajroi/daemon/sweep_processor.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "trajroi/roi/transform.hpp"
+
+namespace trajroi::daemon {
+namespace {
+
+constexpr std::size_t kScratchPoints = 1024;       // more than one packet's 384 points
+constexpr std::int64_t kSpeedBaseline_ns = 500'000'000;
+constexpr double kMaxAdvancePerSweep_m = 10.0;    // projection search window (50 m/s at 5 Hz)
+
+vlp16::Calibration load_calibration(const std::filesystem::path& file) {
+  if (file.empty()) return vlp16::Calibration::vlp16_default();
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw std::runtime_error(file.string() + ": cannot read the lidar calibration");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return vlp16::parse_calibration_yaml(text.str(), file.string());
+}
+
+vlp16::StreamOptions stream_options(const DaemonConfig& c) {
+  vlp16::StreamOptions o;
+  o.decode.min_range_m = c.lidar.min_range_m;
+  o.decode.max_range_m = c.lidar.max_range_m;
+  o.cut_azimuth_deg = c.lidar.cut_azimuth_deg;
+  return o;
+}
+
+pose_input::PoseInputConfig pose_input_config(const DaemonConfig& c) {
+  pose_input::PoseInputConfig p;
+  p.imu.robot_from_imu = c.robot_from_imu;
+  p.imu.magnetic_declination_deg = c.magnetic_declination_deg;
+  p.gnss_delay_ns = std::llround(c.gnss.delay_s * 1e9);
+  p.imu_delay_ns = std::llround(c.imu.delay_s * 1e9);
+  return p;
+}
+
+double size_along(const DaemonConfig::Roi& r) {
+  return r.shape == RoiShape::kCircular ? r.circle_diameter_m : r.rect_height_m;
+}
+
+}  // namespace
+
+PublishedPose PublishedPose::from(const Eigen::Isometry3d& pose) {
+  PublishedPose p;
+  p.position_m = pose.translation();
+  p.orientation = Eigen::Quaterniond(pose.linear()).normalized();
+  if (p.orientation.w() < 0.0) p.orientation.coeffs() = -p.orientation.coeffs();
+  return p;
+}
+
+Eigen::Isometry3d PublishedPose::isometry() const { return roi::pose_from_position_quaternion(position_m, orientation); }
+
+void Sweep::reserve(std::size_t points, std::size_t centre_count) {
+  x.reserve(points);
+  y.reserve(points);
+  z.reserve(points);
+  intensity.reserve(points);
+  ring.reserve(points);
+  return_type.reserve(points);
+  time_offset_ns.reserve(points);
+  centres.reserve(centre_count);
+}
+
+void Sweep::clear_points() noexcept {
+  x.clear();
+  y.clear();
+  z.clear();
+  intensity.clear();
+  ring.clear();
+  return_type.clear();
+  time_offset_ns.clear();
+}
+
+// Routes the stream decoder's callbacks to the processor and on to the caller's sink.
+class SweepProcessor::FrameAdapter final : public vlp16::FrameSink {
+ public:
+  FrameAdapter(SweepProcessor& processor, SweepSink& sink) : processor_(processor), sink_(sink) {}
+  void on_points(const vlp16::Frame& frame, std::size_t first) override { processor_.add_points(frame, first); }
+  void on_frame(const vlp16::Frame& frame) override { processor_.end_sweep(frame, sink_); }
+
+ private:
+  SweepProcessor& processor_;
+  SweepSink& sink_;
+};
+
+SweepProcessor::SweepProcessor(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> trajectory)
+    : config_(config),
+      decoder_(load_calibration(config.lidar.calibration), stream_options(config)),
+      poses_(config.gate, config.gnss_antenna_m, config.pose_capacity),
+      pose_input_(pose::GlobalFrame::local_cartesian(config.origin), pose_input_config(config), poses_),
+      firing_(poses_, config.lidar.robot_from_lidar,
+              config.pose_mode == PoseMode::kPerSweep ? std::numeric_limits<std::int64_t>::max()
+                                                      : vlp16::kFiringCycle_ns),
+      active_(std::move(trajectory)),
+      circles_(config.roi.circle_diameter_m / 2.0, {}, roi::ZLimits{config.roi.z_min_m, config.roi.z_max_m}),
+      rects_(config.roi.rect_height_m, config.roi.rect_width_m, {},
+             roi::ZLimits{config.roi.z_min_m, config.roi.z_max_m}) {
+  if (!active_) throw std::invalid_argument("SweepProcessor: no trajectory");
+  // Preallocate and touch: the largest chain the look-ahead can need, its grid, the sweep.
+  const DaemonConfig::Roi& r = config_.roi;
+  const double longest = r.look_ahead_m + r.max_speed_mps * r.look_ahead_per_mps_s;
+  const auto centres = static_cast<std::size_t>(longest / (r.spacing_ratio * size_along(r))) + 2;
+  sweep_.reserve(config_.buffers.max_points_per_sweep, centres);
+  scratch_.reserve(kScratchPoints);
+  kept_.reserve(kScratchPoints);
+  roi::place_centres(active_->trajectory, 0.0, longest, r.spacing_ratio * size_along(r), sweep_.centres);
+  circles_.assign(sweep_.centres);
+  rects_.assign(sweep_.centres);
+  circle_grid_.build(circles_);
+  rect_grid_.build(rects_);
+  sweep_.centres.clear();
+}
+
+SweepProcessor::~SweepProcessor() = default;
+
+void SweepProcessor::lidar_datagram(LidarPort port, std::span<const std::uint8_t> payload, std::int64_t receive_ns,
+                                    SweepSink& sink) {
+  if (port == LidarPort::kPosition) {
+    decoder_.on_position_packet(payload);
+    return;
+  }
+  FrameAdapter adapter(*this, sink);
+  decoder_.on_data_packet(payload, receive_ns, adapter);
+}
+
+void SweepProcessor::flush(SweepSink& sink) {
+  FrameAdapter adapter(*this, sink);
+  decoder_.flush(adapter);
+}
+
+void SweepProcessor::offer_trajectory(std::unique_ptr<ActiveTrajectory> trajectory) {
+  if (pending_) retired_ = std::move(pending_);
+  pending_ = std::move(trajectory);
+}
+
+std::unique_ptr<ActiveTrajectory> SweepProcessor::take_retired() noexcept { return std::move(retired_); }
+
+void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
+  in_sweep_ = true;
+  if (pending_) {
+    retired_ = std::move(active_);
+    active_ = std::move(pending_);
+    have_hint_ = false;
+    ++counters_.trajectory_swaps;
+  }
+  const DaemonConfig::Roi& r = config_.roi;
+  Sweep& s = sweep_;
+  s.clear_points();
+  s.centres.clear();
+  s.truncated = 0;
+  s.start_ns = frame.start_time_ns;
+  s.pose_t_ns = frame.start_time_ns;
+  s.trajectory_id = active_->id;
+  s.shape = r.shape;
+  s.speed_mps = 0.0;
+  const pose::GnssFix* fix = poses_.newest_fix();
+  s.fix = fix != nullptr ? fix->quality : pose::FixQuality{};
+  s.fix_t_ns = fix != nullptr ? fix->t_ns : 0;
+  firing_.reset();
+
+  const pose::PoseQuery q = poses_.pose_at(frame.start_time_ns);
+  s.pose_status = q.status;
+  s.filtered = q.valid();
+  if (!s.filtered) {
+    have_hint_ = false;
+    return;
+  }
+  s.robot = PublishedPose::from(q.global_from_robot);
+  s.sensor = PublishedPose::from(s.robot.isometry() * config_.lidar.robot_from_lidar);
+  sweep_sensor_pose_ = s.sensor.isometry();
+  const Eigen::Vector2d position = q.global_from_robot.translation().head<2>();
+  const pose::PoseQuery before = poses_.pose_at(frame.start_time_ns - kSpeedBaseline_ns);
+  if (before.valid()) {
+    s.speed_mps = (position - before.global_from_robot.translation().head<2>()).norm() / (kSpeedBaseline_ns * 1e-9);
+  }
+
+  const roi::Trajectory& trajectory = active_->trajectory;
+  const roi::Projection p = have_hint_ ? trajectory.project(position, s_hint_m_, kMaxAdvancePerSweep_m)
+                                       : trajectory.project(position);
+  s_hint_m_ = p.s_m;
+  have_hint_ = true;
+  const double speed = std::min(s.speed_mps, r.max_speed_mps);
+  s.start_s_m = p.s_m;
+  s.look_ahead_m = r.look_ahead_m + speed * r.look_ahead_per_mps_s;
+  const double grow = speed * r.width_per_mps_s;
+  if (r.shape == RoiShape::kCircular) {
+    s.radius_m = (r.circle_diameter_m + grow) / 2.0;
+    s.height_m = 0.0;
+    s.width_m = 0.0;
+    s.spacing_m = roi::spacing_from_ratio(r.spacing_ratio, r.circle_diameter_m + grow);
+    roi::place_centres(trajectory, s.start_s_m, s.look_ahead_m, s.spacing_m, s.centres);
+    circles_.assign(s.centres, s.radius_m);
+    circle_grid_.build(circles_);
+  } else {
+    s.radius_m = 0.0;
+    s.height_m = r.rect_height_m;
+    s.width_m = r.rect_width_m + grow;
+    s.spacing_m = roi::spacing_from_ratio(r.spacing_ratio, r.rect_height_m);
+    roi::place_centres(trajectory, s.start_s_m, s.look_ahead_m, s.spacing_m, s.centres);
+    rects_.assign(s.centres, s.height_m, s.width_m);
+    rect_grid_.build(rects_);
+  }
+}
+
+void SweepProcessor::add_points(const vlp16::Frame& frame, std::size_t first) {
+  if (first == 0 || !in_sweep_) start_sweep(frame);
+  sweep_.last_packet_arrival_ns = arrival_ns_;
+  const std::size_t end = frame.points.size();
+  if (!sweep_.filtered) return;
+  if (config_.pose_mode == PoseMode::kPerSweep) {
+    for (std::size_t i = first; i < end; i += kScratchPoints) {
+      filter_run(frame, i, std::min(end, i + kScratchPoints), sweep_sensor_pose_);
+    }
+    return;
+  }
+  // Per firing: consecutive points of one firing period share a pose.
+  std::size_t i = first;
+  while (i < end) {
+    pose::PoseStatus status{};
+    const Eigen::Isometry3d* pose = firing_.at(frame.start_time_ns + frame.points[i].time_offset_ns, status);
+    if (pose == nullptr) {
+      sweep_.filtered = false;
+      sweep_.pose_status = status;
+      sweep_.clear_points();
+      have_hint_ = false;
+      return;
+    }
+    const Eigen::Isometry3d global_from_lidar = *pose;
+    const std::uint64_t generation = firing_.generation();
+    std::size_t j = i + 1;
+    while (j < end && j - i < kScratchPoints) {
+      (void)firing_.at(frame.start_time_ns + frame.points[j].time_offset_ns, status);
+      if (firing_.generation() != generation) break;
+      ++j;
+    }
+    filter_run(frame, i, j, global_from_lidar);
+    i = j;
+  }
+}
+
+void SweepProcessor::filter_run(const vlp16::Frame& frame, std::size_t first, std::size_t end,
+                                const Eigen::Isometry3d& global_from_lidar) {
+  scratch_.resize(end - first);
+  for (std::size_t i = first; i < end; ++i) {
+    const vlp16::Point& p = frame.points[i];
+    scratch_[i - first] = roi::PointXYZI{p.x, p.y, p.z, static_cast<float>(p.intensity)};
+  }
+  roi::transform_points(global_from_lidar, scratch_, scratch_);
+  const std::span<const roi::PointXYZI> placed(scratch_);
+  if (config_.roi.shape == RoiShape::kCircular) {
+    (void)circle_grid_.filter(placed, kept_);
+  } else {
+    (void)rect_grid_.filter(placed, kept_);
+  }
+  Sweep& s = sweep_;
+  const std::size_t room = config_.buffers.max_points_per_sweep - std::min(config_.buffers.max_points_per_sweep, s.size());
+  const std::size_t n = std::min(room, kept_.size());
+  s.truncated += static_cast<std::uint32_t>(kept_.size() - n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const roi::PointXYZI& g = scratch_[kept_[k]];
+    const vlp16::Point& p = frame.points[first + kept_[k]];
+    s.x.push_back(g.x);
+    s.y.push_back(g.y);
+    s.z.push_back(g.z);
+    s.intensity.push_back(p.intensity);
+    s.ring.push_back(p.ring);
+    s.return_type.push_back(static_cast<std::uint8_t>(p.return_type));
+    s.time_offset_ns.push_back(static_cast<std::int32_t>(p.time_offset_ns));
+  }
+}
+
+void SweepProcessor::end_sweep(const vlp16::Frame& frame, SweepSink& sink) {
+  if (!in_sweep_) start_sweep(frame);  // a frame of packets without points
+  in_sweep_ = false;
+  Sweep& s = sweep_;
+  s.index = frame.index;
+  s.end_ns = frame.end_time_ns;
+  s.partial = frame.partial;
+  s.return_mode = static_cast<std::uint8_t>(frame.return_mode);
+  s.points_in = static_cast<std::uint32_t>(frame.points.size());
+  s.lost_packets = frame.lost_packets;
+  ++counters_.sweeps;
+  counters_.points_in += frame.points.size();
+  if (s.filtered) {
+    ++counters_.sweeps_filtered;
+    counters_.points_kept += s.size();
+    counters_.points_truncated += s.truncated;
+  } else {
+    ++counters_.sweeps_without_pose;
+    s.clear_points();
+  }
+  sink.on_sweep(s);
+}
+
+}  // namespace trajroi::daemon

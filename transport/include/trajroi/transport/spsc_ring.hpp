@@ -1,0 +1,101 @@
+#pragma once
+
+// A bounded, preallocated, lock-free ring between exactly one producer thread and one
+// consumer thread (Lamport's queue with cached indices, as in rigtorp::SPSCQueue and the
+// Linux kernel's kfifo). Items live in the ring: the producer fills a slot in place and
+// publishes it, the consumer reads it in place and releases it, so nothing is copied twice
+// and nothing is allocated after construction.
+//
+// A full ring never blocks the producer: try_claim() returns nullptr and the caller drops
+// the newest item, counting it with count_drop() (the counter is readable from any thread).
+//
+// Memory order: publish() stores the tail with release after the slot is written; the
+// consumer's acquire load of the tail makes the slot's contents visible; release() stores the
+// head with release so the producer's acquire load knows the slot is free again.
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <new>
+#include <stdexcept>
+#include <type_traits>
+
+namespace trajroi::transport {
+
+inline constexpr std::size_t kCacheLine = 64;
+
+template <typename T>
+class SpscRing {
+ public:
+  // `capacity` is rounded up to a power of two (at least 2). Every slot is constructed now
+  // with `make()` (or value-initialised) and its memory touched, so the steady state takes no
+  // page faults.
+  explicit SpscRing(std::size_t capacity) : SpscRing(capacity, [] { return T{}; }) {}
+  template <typename Make>
+  SpscRing(std::size_t capacity, Make make) : mask_(round_up(capacity) - 1), slots_(new Slot[mask_ + 1]) {
+    for (std::size_t i = 0; i <= mask_; ++i) slots_[i].item = make();
+  }
+
+  SpscRing(const SpscRing&) = delete;
+  SpscRing& operator=(const SpscRing&) = delete;
+
+  [[nodiscard]] std::size_t capacity() const noexcept { return mask_ + 1; }
+
+  // ---- producer ----
+  // The next free slot to fill, or nullptr when the ring is full.
+  [[nodiscard]] T* try_claim() noexcept {
+    const std::size_t tail = tail_.load(std::memory_order_relaxed);
+    if (tail - head_cache_ > mask_) {
+      head_cache_ = head_.load(std::memory_order_acquire);
+      if (tail - head_cache_ > mask_) return nullptr;
+    }
+    return &slots_[tail & mask_].item;
+  }
+  // Makes the slot try_claim() returned visible to the consumer.
+  void publish() noexcept { tail_.store(tail_.load(std::memory_order_relaxed) + 1, std::memory_order_release); }
+  // A claim that failed: the newest item is dropped.
+  void count_drop() noexcept { dropped_.fetch_add(1, std::memory_order_relaxed); }
+
+  // ---- consumer ----
+  // The oldest published item, or nullptr when the ring is empty.
+  [[nodiscard]] T* front() noexcept {
+    const std::size_t head = head_.load(std::memory_order_relaxed);
+    if (head == tail_cache_) {
+      tail_cache_ = tail_.load(std::memory_order_acquire);
+      if (head == tail_cache_) return nullptr;
+    }
+    return &slots_[head & mask_].item;
+  }
+  // Frees the slot front() returned.
+  void release() noexcept { head_.store(head_.load(std::memory_order_relaxed) + 1, std::memory_order_release); }
+
+  // ---- any thread ----
+  [[nodiscard]] std::uint64_t dropped() const noexcept { return dropped_.load(std::memory_order_relaxed); }
+  // Items waiting (a snapshot; exact only from the consumer while the producer is idle).
+  [[nodiscard]] std::size_t size() const noexcept {
+    return tail_.load(std::memory_order_acquire) - head_.load(std::memory_order_acquire);
+  }
+
+ private:
+  static std::size_t round_up(std::size_t n) {
+    if (n > (std::size_t{1} << 30)) throw std::invalid_argument("SpscRing: capacity above 2^30");
+    std::size_t c = 2;
+    while (c < n) c <<= 1;
+    return c;
+  }
+  struct alignas(kCacheLine) Slot {
+    T item;
+  };
+
+  const std::size_t mask_;
+  const std::unique_ptr<Slot[]> slots_;
+  // Producer's line: its index and its cached copy of the consumer's.
+  alignas(kCacheLine) std::atomic<std::size_t> tail_{0};
+  std::size_t head_cache_ = 0;
+  // Consumer's line.
+  alignas(kCacheLine) std::atomic<std::size_t> head_{0};
+  std::size_t tail_cache_ = 0;
+  alignas(kCacheLine) std::atomic<std::uint64_t> dropped_{0};
+};
+
+}  // namespace trajroi::transport
