@@ -3,10 +3,13 @@
 
 #include <cstdio>
 #include <exception>
+#include <fstream>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include "log.hpp"
+#include "trajroi/roi/trajectory.hpp"
 #include "trajroid.hpp"
 
 int main(int argc, char** argv) {
@@ -51,6 +54,18 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "trajroid: --rate: expected realtime, max or a factor > 0, got '%s'\n", rate.c_str());
       return kExitConfig;
     }
+  }
+  try {
+    // The trajectory file is part of the configuration: checked here, loaded again at start.
+    std::ifstream in(config.trajectory_file, std::ios::binary);
+    if (!in) throw std::runtime_error("cannot be read");
+    std::ostringstream text;
+    text << in.rdbuf();
+    (void)trajroi::roi::parse_trajectory_csv(text.str(), config.trajectory_file.string());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "trajroid: configuration error: %s: trajectory.file: %s: %s\n", config_file.c_str(),
+                 config.trajectory_file.c_str(), e.what());
+    return kExitConfig;
   }
   if (check_config) {
     std::printf("%s: configuration OK (trajectory %s, ROI %s, pose %s, LCM %s)\n", config_file.c_str(),

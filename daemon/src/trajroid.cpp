@@ -99,10 +99,17 @@ class Daemon;
 // Hands each finished sweep to the publisher's ring (copied into a preallocated slot).
 class RingSink final : public SweepSink {
  public:
-  RingSink(Ring<Sweep>& ring, const EventFd& wake) : ring_(ring), wake_(wake) {}
+  // `wait_for_room`: an as-fast-as-possible replay waits for the publisher (exact output);
+  // otherwise a full ring drops the sweep and counts it.
+  RingSink(Ring<Sweep>& ring, const EventFd& wake, bool wait_for_room, const std::atomic<bool>& stop)
+      : ring_(ring), wake_(wake), wait_(wait_for_room), stop_(stop) {}
   void on_sweep(const Sweep& sweep) override {
     const std::int64_t now = steady_ns();
     Sweep* slot = ring_.try_claim();
+    while (slot == nullptr && wait_ && !stop_.load(std::memory_order_relaxed)) {
+      std::this_thread::sleep_for(std::chrono::microseconds(20));
+      slot = ring_.try_claim();
+    }
     if (slot == nullptr) {
       ring_.count_drop();
     } else {
@@ -120,6 +127,8 @@ class RingSink final : public SweepSink {
  private:
   Ring<Sweep>& ring_;
   const EventFd& wake_;
+  bool wait_;
+  const std::atomic<bool>& stop_;
   std::int64_t accumulated_ns_ = 0;
   std::int64_t packet_start_ns_ = 0;
 };
@@ -508,7 +517,7 @@ void Daemon::processing() {
     log::warn("{}", w);
   }
   prefault_stack();
-  RingSink sink(sweeps_, publish_wake_);
+  RingSink sink(sweeps_, publish_wake_, options_.replay.has_value() && options_.rate == 0.0, stop_);
   std::int64_t next_status = steady_ns() + kSecond_ns;
   for (;;) {
     processing_beat_.fetch_add(1, std::memory_order_relaxed);

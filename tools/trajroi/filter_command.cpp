@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -34,6 +35,9 @@ struct FilterOptions {
   double z_min_m = -std::numeric_limits<double>::infinity();
   double z_max_m = std::numeric_limits<double>::infinity();
   std::string pose = "0,0,0";
+  double start_s_m = 0.0;
+  double look_ahead_m = std::numeric_limits<double>::infinity();
+  std::string cloud_precision = "double";
   std::string algorithm = "fast";
   std::string output_path;
 };
@@ -43,13 +47,22 @@ double require(const std::optional<double>& value, const char* option, const std
   return *value;
 }
 
+// 'x_m,y_m,yaw_deg' (planar), or 'x,y,z,qw,qx,qy,qz' (a full pose as trajroid publishes it,
+// rebuilt exactly as trajroid rebuilds it).
 Eigen::Isometry3d parse_pose(const std::string& text) {
-  double values[3];
-  if (roi::parse_csv_doubles(text, values) != 3 || !std::isfinite(values[0]) ||
-      !std::isfinite(values[1]) || !std::isfinite(values[2])) {
-    throw std::invalid_argument("--pose expects 'x_m,y_m,yaw_deg' with finite numbers, got '" + text + "'");
+  double v[7];
+  const std::size_t n = roi::parse_csv_doubles(text, v);
+  const bool finite = std::all_of(v, v + std::min<std::size_t>(n, 7), [](double x) { return std::isfinite(x); });
+  if (n == 3 && finite) return roi::pose_from_xy_yaw(v[0], v[1], v[2] * std::numbers::pi / 180.0);
+  if (n == 7 && finite) {
+    const Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
+    if (std::abs(q.norm() - 1.0) > 1e-9) {
+      throw std::invalid_argument("--pose: the quaternion (qw,qx,qy,qz) must have unit norm, got '" + text + "'");
+    }
+    return roi::pose_from_position_quaternion(Eigen::Vector3d(v[0], v[1], v[2]), q);
   }
-  return roi::pose_from_xy_yaw(values[0], values[1], values[2] * std::numbers::pi / 180.0);
+  throw std::invalid_argument("--pose expects 'x_m,y_m,yaw_deg' or 'x,y,z,qw,qx,qy,qz' with finite numbers, got '" +
+                              text + "'");
 }
 
 double spacing(const FilterOptions& o, double size_along_m) {
@@ -81,6 +94,13 @@ void run_filter(const FilterOptions& o) {
       eval::parse_points_csv(read_text_file(o.points_path), o.points_path);
   const Eigen::Isometry3d global_from_sensor = parse_pose(o.pose);
   roi::transform_points(global_from_sensor, points, points);
+  if (o.cloud_precision == "float") {
+    // As trajroid stores placed points (and LCM carries them): float32.
+    for (roi::PointXYZd& p : points) {
+      p = {static_cast<double>(static_cast<float>(p.x)), static_cast<double>(static_cast<float>(p.y)),
+           static_cast<double>(static_cast<float>(p.z))};
+    }
+  }
   const roi::ZLimits z{o.z_min_m, o.z_max_m};
   const double inf = std::numeric_limits<double>::infinity();
 
@@ -89,12 +109,12 @@ void run_filter(const FilterOptions& o) {
   std::vector<roi::Centre> centres;
   if (o.shape == "circular") {
     const double diameter = require(o.diameter_m, "--diameter", o.shape);
-    roi::place_centres(trajectory, 0.0, inf, spacing(o, diameter), centres);
+    roi::place_centres(trajectory, o.start_s_m, o.look_ahead_m, spacing(o, diameter), centres);
     stats = run_chain(roi::CircularRoiSet(diameter / 2.0, centres, z), o.algorithm, points, kept);
   } else if (o.shape == "rectangular") {
     const double height = require(o.height_m, "--height", o.shape);
     const double width = require(o.width_m, "--width", o.shape);
-    roi::place_centres(trajectory, 0.0, inf, spacing(o, height), centres);
+    roi::place_centres(trajectory, o.start_s_m, o.look_ahead_m, spacing(o, height), centres);
     stats = run_chain(roi::RectangularRoiSet(height, width, centres, z), o.algorithm, points, kept);
   } else if (o.shape == "corridor") {
     const double width = require(o.width_m, "--width", o.shape);
@@ -143,7 +163,14 @@ void add_filter_command(CLI::App& app) {
   spacing_opt->excludes(ratio_opt);
   cmd->add_option("--z-min", o->z_min_m, "Lowest z kept [m] (global frame; robot frame for cuboid)");
   cmd->add_option("--z-max", o->z_max_m, "Highest z kept [m]");
-  cmd->add_option("--pose", o->pose, "Robot pose 'x_m,y_m,yaw_deg' (sensor frame = robot frame)")
+  cmd->add_option("--pose", o->pose, "Sensor pose: 'x_m,y_m,yaw_deg', or 'x,y,z,qw,qx,qy,qz' as in trajroid's points_t")
+      ->capture_default_str();
+  cmd->add_option("--start-s", o->start_s_m, "Arc length of the first centre [m] (circular, rectangular)")
+      ->capture_default_str();
+  cmd->add_option("--look-ahead", o->look_ahead_m, "Chain length from --start-s [m] (default: to the end)");
+  cmd->add_option("--cloud-precision", o->cloud_precision,
+                  "Precision of the placed points: double, or float as trajroid stores them")
+      ->check(CLI::IsMember({"double", "float"}))
       ->capture_default_str();
   cmd->add_option("--algorithm", o->algorithm, "Membership implementation")
       ->check(CLI::IsMember({"reference", "fast"}))
