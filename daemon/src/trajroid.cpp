@@ -46,6 +46,7 @@ std::int64_t clock_ns(clockid_t clock) noexcept {
   return static_cast<std::int64_t>(ts.tv_sec) * kSecond_ns + ts.tv_nsec;
 }
 std::int64_t steady_ns() noexcept { return clock_ns(CLOCK_MONOTONIC); }
+std::int64_t thread_cpu_ns() noexcept { return clock_ns(CLOCK_THREAD_CPUTIME_ID); }
 
 class EventFd {
  public:
@@ -220,6 +221,8 @@ class Daemon {
   std::atomic<bool> lidar_done_{false}, gnss_done_{false}, imu_done_{false};
   std::atomic<bool> processing_done_{false}, publishing_done_{false}, recording_done_{false};
   std::atomic<std::uint64_t> processing_beat_{0}, publishing_beat_{0};
+  // CPU time of each kind of thread, added as each ends (for the summary).
+  std::atomic<std::int64_t> cpu_sources_ns_{0}, cpu_processing_ns_{0}, cpu_publishing_ns_{0};
   std::atomic<std::uint64_t> oversize_datagrams_{0}, source_errors_{0}, serial_disconnects_{0};
 
   // Publisher-owned.
@@ -313,6 +316,7 @@ void Daemon::lidar_live() {
       std::copy(d.payload.begin(), d.payload.end(), item.bytes.begin());
     });
   }
+  cpu_sources_ns_.fetch_add(thread_cpu_ns());
   lidar_done_.store(true, std::memory_order_release);
 }
 
@@ -341,6 +345,7 @@ void Daemon::serial_live(serial::SerialPortSource& source, Ring<SerialItem>& rin
       warn_rate_limited(source.describe() + ": disconnected (" + source.last_error() + "); reopening");
     }
   }
+  cpu_sources_ns_.fetch_add(thread_cpu_ns());
   done.store(true, std::memory_order_release);
 }
 
@@ -423,6 +428,7 @@ void Daemon::replay() {
       next_serial(imu_replay_.get(), imu);
     }
   }
+  cpu_sources_ns_.fetch_add(thread_cpu_ns());
   lidar_done_.store(true, std::memory_order_release);
   gnss_done_.store(true, std::memory_order_release);
   imu_done_.store(true, std::memory_order_release);
@@ -594,6 +600,7 @@ void Daemon::processing() {
     if (handled == 0) process_wake_.wait(kIdleWait_ms);
   }
   snapshot(true);
+  cpu_processing_ns_.fetch_add(thread_cpu_ns());
   processing_done_.store(true, std::memory_order_release);
   publish_wake_.notify();
   record_wake_.notify();
@@ -631,6 +638,7 @@ void Daemon::publish_status(lcm::LCM& lcm, const StatusSnapshot& s) {
   m.wall_time_ns = clock_ns(CLOCK_REALTIME);
   m.uptime_s = static_cast<double>(s.steady_ns - start_steady_ns_) * 1e-9;
   m.replay = options_.replay.has_value();
+  m.final_status = s.final;
   m.trajectory_id = s.trajectory_id;
   m.lidar_packets = static_cast<std::int64_t>(s.lidar_packets);
   m.position_packets = static_cast<std::int64_t>(s.position_packets);
@@ -745,6 +753,7 @@ void Daemon::publishing(lcm::LCM& lcm) {
       break;
     }
   }
+  cpu_publishing_ns_.fetch_add(thread_cpu_ns());
   publishing_done_.store(true, std::memory_order_release);
   main_wake_.notify();
 }
@@ -901,6 +910,9 @@ int Daemon::run() {
             s.processor.points_in > 0 ? 100.0 * static_cast<double>(s.processor.points_kept) / static_cast<double>(s.processor.points_in) : 0.0,
             percentile(latency_all_ms_, 0.5), percentile(latency_all_ms_, 0.99), latency_all_ms_.size(), drops,
             s.lost_packets, s.decode_errors);
+  log::info("cpu: sources {:.3f} s ({}), processing {:.3f} s, publishing {:.3f} s",
+            static_cast<double>(cpu_sources_ns_.load()) * 1e-9, options_.replay ? "replay reader" : "receive threads",
+            static_cast<double>(cpu_processing_ns_.load()) * 1e-9, static_cast<double>(cpu_publishing_ns_.load()) * 1e-9);
   return 0;
 }
 

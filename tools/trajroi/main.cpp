@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   trajroi::cli::add_serial_dump_commands(app);
   trajroi::cli::add_sim_command(app);
   trajroi::cli::add_render_command(app);
+  trajroi::cli::add_watch_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -38,38 +38,6 @@ void push_point(std::vector<Point>& out, const Eigen::Vector3d& p, float intensi
   }
 }
 
-// Ground truth for one chain: within width/2 of the trajectory between arc lengths s0 and
-// s1 (round ends); with square ends also in front of the first ROI's back edge and behind the
-// last ROI's front edge — the planes through c_first − a/2·u_first and c_last + a/2·u_last.
-class TruthCorridor {
- public:
-  TruthCorridor(const roi::Trajectory& t, std::span<const roi::Centre> centres, double half_along_m, double width_m,
-                bool square_ends)
-      : set_(t, centres.front().s_m - half_along_m, centres.back().s_m + half_along_m, width_m), square_(square_ends) {
-    const roi::Centre& first = centres.front();
-    const roi::Centre& last = centres.back();
-    start_dir_ = {std::cos(first.theta_rad), std::sin(first.theta_rad)};
-    end_dir_ = {std::cos(last.theta_rad), std::sin(last.theta_rad)};
-    start_ = first.position - half_along_m * start_dir_;
-    end_ = last.position + half_along_m * end_dir_;
-  }
-  [[nodiscard]] bool contains(double x, double y) const noexcept {
-    if (square_) {
-      const Eigen::Vector2d p(x, y);
-      if ((p - start_).dot(start_dir_) < 0.0 || (p - end_).dot(end_dir_) > 0.0) return false;
-    }
-    for (std::size_t j = 0; j < set_.size(); ++j) {
-      if (set_.contains(j, x, y)) return true;
-    }
-    return false;
-  }
-
- private:
-  roi::CorridorRoiSet set_;
-  bool square_;
-  Eigen::Vector2d start_, end_, start_dir_, end_dir_;
-};
-
 double elapsed_ms(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
 }

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# trajroid's performance figures, printed (not a timed test): a dual-return scenario
+# (tests/daemon/corridor.yaml, 28.8 s) replayed through the daemon publishing over LCM on
+# loopback, (1) at real-time pace: latency from the last packet of a sweep to its LCM
+# publication (p50, p99), CPU time per second of data, ring drops; (2) as fast as possible:
+# the replay speed as a multiple of real time.
+# Usage: bench/daemon_figures.sh [BUILD_DIR]   (default build/release)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=${1:-build/release}
+run=$(mktemp -d)/corridor
+trap 'rm -rf "$(dirname "$run")"' EXIT
+"$build/tools/trajroi" sim --quiet --scenario tests/daemon/corridor.yaml --out "$run" >/dev/null
+duration=$(awk '/^duration_s/ {print $2}' "$run/summary.txt")
+
+figures() {  # rate → "latency_p50 latency_p99 drops wall_s cpu_s pipeline_cpu_s"
+  local log
+  log=$( { /usr/bin/time -f "TIME %e %U %S" "$build/daemon/trajroid" --config "$run/trajroid.yaml" --replay "$run" \
+           --rate "$1" 2>&1; } 2>&1 )
+  local summary
+  summary=$(grep "summary:" <<<"$log")
+  local p50 p99 drops
+  p50=$(sed -n 's/.*latency p50 \([0-9.]*\) ms.*/\1/p' <<<"$summary")
+  p99=$(sed -n 's/.*p99 \([0-9.]*\) ms over.*/\1/p' <<<"$summary")
+  drops=$(sed -n 's/.*ring drops \([0-9]*\).*/\1/p' <<<"$summary")
+  read -r _ wall user sys < <(grep "^TIME" <<<"$log")
+  local pipeline
+  pipeline=$(sed -n 's/.*processing \([0-9.]*\) s, publishing \([0-9.]*\) s.*/\1 \2/p' <<<"$log" | awk '{print $1 + $2}')
+  echo "$p50 $p99 $drops $wall $(awk -v u="$user" -v s="$sys" 'BEGIN {print u + s}') $pipeline"
+}
+
+echo "scenario: tests/daemon/corridor.yaml, dual return, ${duration} s of data"
+read -r p50 p99 drops wall cpu pipeline < <(figures realtime)
+echo "real-time replay: latency last packet → LCM p50 ${p50} ms, p99 ${p99} ms (goal p99 <= 2 ms); ring drops ${drops} (goal 0)"
+awk -v c="$cpu" -v p="$pipeline" -v d="$duration" 'BEGIN {
+  printf "real-time replay: CPU of the pipeline (processing + publishing threads) %.3f s for %.1f s of data = %.2f %% of one core (goal <= 5 %%)\n", p, d, 100 * p / d
+  printf "real-time replay: CPU of the whole process, the replay reader standing in for the sensors included, %.3f s = %.2f %%\n", c, 100 * c / d}'
+read -r _ _ drops wall _ _ < <(figures max)
+awk -v w="$wall" -v d="$duration" -v x="$drops" 'BEGIN {printf "as fast as possible: %.1f s of data in %.2f s = %.0fx real time (goal >= 100x); ring drops %d\n", d, w, d / w, x}'

@@ -1,0 +1,201 @@
+// trajroi watch: listens to trajroid over LCM, prints its status each second and, given the
+// run folder a replay came from, scores every published sweep against the scenario's truth:
+// the sweep is decoded from the same capture, each point placed with the true pose, and the
+// ground truth is the corridor matched to the sweep's published ROI chain (as the keyframe
+// evaluation does). Ends at the daemon's final status (or after --seconds).
+#include <chrono>
+#include <cstdio>
+#include <deque>
+#include <lcm/lcm-cpp.hpp>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <tuple>
+
+#include "commands.hpp"
+#include "trajroi/eval/scenario_eval.hpp"
+#include "trajroi/points_t.hpp"
+#include "trajroi/roi/metrics.hpp"
+#include "trajroi/roi_t.hpp"
+#include "trajroi/sim/run_folder.hpp"
+#include "trajroi/status_t.hpp"
+#include "trajroi/vlp16/pcap_source.hpp"
+#include "trajroi/vlp16/stream_decoder.hpp"
+
+namespace trajroi::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct WatchOptions {
+  std::string url = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304";
+  std::string prefix = "TRAJROI";
+  std::string run_dir;
+  double seconds = 0.0;
+};
+
+// The run's capture decoded frame by frame, in step with the sweeps the daemon publishes.
+class TruthScorer {
+ public:
+  explicit TruthScorer(const fs::path& dir)
+      : run_(dir), source_(dir / sim::kLidarFile), decoder_(vlp16::Calibration::vlp16_default(), options(run_)) {}
+
+  void score(const trajroi::points_t& m, const trajroi::roi_t& roi) {
+    const vlp16::Frame* frame = frame_at(static_cast<std::uint64_t>(m.sweep_index));
+    if (frame == nullptr || roi.num_centres == 0) return;
+    std::vector<roi::Centre> centres;
+    for (std::size_t i = 0; i < roi.cx.size(); ++i) {
+      centres.push_back({{roi.cx[i], roi.cy[i]}, roi.theta_rad[i], roi.start_s_m + roi.spacing_m * static_cast<double>(i)});
+    }
+    const bool circles = roi.shape == trajroi::roi_t::CIRCULAR;
+    const eval::TruthCorridor corridor(run_.trajectory(), centres, circles ? 0.0 : roi.height_m / 2.0,
+                                       circles ? 2.0 * roi.radius_m : roi.width_m, !circles);
+    eval::place_frame_truth(*frame, run_.truth(), run_.robot_from_lidar(), truth_points_);
+    std::map<std::tuple<std::int64_t, int, int>, std::size_t> index;
+    for (std::size_t i = 0; i < frame->points.size(); ++i) {
+      const auto& p = frame->points[i];
+      index[{frame->start_time_ns + p.time_offset_ns, p.ring, static_cast<int>(p.return_type)}] = i;
+    }
+    roi::IndexVector kept;
+    for (std::size_t k = 0; k < m.x.size(); ++k) {
+      const auto it = index.find({m.sweep_start_ns + m.time_offset_ns[k], m.ring[k], m.return_type[k]});
+      if (it != index.end()) kept.push_back(static_cast<std::uint32_t>(it->second));
+    }
+    std::sort(kept.begin(), kept.end());
+    std::vector<std::uint8_t> truth(truth_points_.size());
+    for (std::size_t i = 0; i < truth.size(); ++i) truth[i] = corridor.contains(truth_points_[i].x, truth_points_[i].y) ? 1 : 0;
+    const roi::Confusion c = roi::confusion(kept, truth);
+    total_.tp += c.tp;
+    total_.fp += c.fp;
+    total_.fn += c.fn;
+    total_.tn += c.tn;
+    ++scored_;
+  }
+  [[nodiscard]] const roi::Confusion& total() const noexcept { return total_; }
+  [[nodiscard]] std::size_t scored() const noexcept { return scored_; }
+
+ private:
+  static vlp16::StreamOptions options(const eval::ScenarioRun& run) {
+    vlp16::StreamOptions o;
+    o.decode.min_range_m = run.scenario().lidar.min_range_m;
+    o.decode.max_range_m = run.scenario().lidar.max_range_m;
+    return o;
+  }
+  const vlp16::Frame* frame_at(std::uint64_t index) {
+    struct Keep final : vlp16::FrameSink {
+      std::deque<vlp16::Frame>* frames;
+      void on_frame(const vlp16::Frame& f) override { frames->push_back(f); }
+    } keep;
+    keep.frames = &frames_;
+    while (!frames_.empty() && frames_.front().index < index) frames_.pop_front();
+    vlp16::Datagram d;
+    while ((frames_.empty() || frames_.back().index < index) && !ended_) {
+      if (source_.next(d) != vlp16::PacketSource::Next::kDatagram) {
+        decoder_.flush(keep);
+        ended_ = true;
+      } else if (d.destination_port == vlp16::kDataPort) {
+        decoder_.on_data_packet(d.payload, d.receive_time_ns, keep);
+      } else {
+        decoder_.on_position_packet(d.payload);
+      }
+    }
+    for (const auto& f : frames_) {
+      if (f.index == index) return &f;
+    }
+    return nullptr;
+  }
+
+  eval::ScenarioRun run_;
+  vlp16::PcapSource source_;
+  vlp16::StreamDecoder decoder_;
+  std::deque<vlp16::Frame> frames_;
+  bool ended_ = false;
+  std::vector<roi::PointXYZd> truth_points_;
+  roi::Confusion total_{};
+  std::size_t scored_ = 0;
+};
+
+class Watcher {
+ public:
+  explicit Watcher(const WatchOptions& o) : o_(o), lcm_(o.url) {
+    if (!lcm_.good()) throw std::runtime_error("LCM: cannot open '" + o.url + "'");
+    if (!o.run_dir.empty()) scorer_ = std::make_unique<TruthScorer>(o.run_dir);
+    lcm_.subscribe(o.prefix + "_POINTS", &Watcher::on_points, this);
+    lcm_.subscribe(o.prefix + "_ROI", &Watcher::on_roi, this);
+    lcm_.subscribe(o.prefix + "_STATUS", &Watcher::on_status, this);
+  }
+
+  void run() {
+    const auto start = std::chrono::steady_clock::now();
+    while (!done_) {
+      lcm_.handleTimeout(100);
+      if (o_.seconds > 0.0 &&
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > o_.seconds) {
+        break;
+      }
+    }
+    std::printf("trajroi watch: %zu sweeps heard", points_heard_);
+    if (last_) {
+      const auto& s = *last_;
+      std::printf(" of %lld published (%lld withheld without a valid pose); points in %lld, kept %lld; "
+                  "latency p50 %.3f ms p99 %.3f ms (last second); ring drops %lld",
+                  static_cast<long long>(s.sweeps_published), static_cast<long long>(s.sweeps_without_pose),
+                  static_cast<long long>(s.points_in), static_cast<long long>(s.points_kept), s.latency_ms_p50,
+                  s.latency_ms_p99, static_cast<long long>(s.ring_drops));
+    }
+    std::printf("\n");
+    if (scorer_ && scorer_->scored() > 0) {
+      const roi::Confusion& c = scorer_->total();
+      std::printf("trajroi watch: against the scenario's truth over %zu sweeps: precision %.4f, recall %.4f, accuracy %.4f "
+                  "(TP %llu, FP %llu, FN %llu, TN %llu)\n",
+                  scorer_->scored(), c.precision(), c.recall(), c.accuracy(),
+                  static_cast<unsigned long long>(c.tp), static_cast<unsigned long long>(c.fp),
+                  static_cast<unsigned long long>(c.fn), static_cast<unsigned long long>(c.tn));
+    }
+  }
+
+ private:
+  void on_points(const lcm::ReceiveBuffer*, const std::string&, const trajroi::points_t* m) {
+    ++points_heard_;
+    const auto roi = rois_.find(m->sweep_index);
+    if (scorer_ && roi != rois_.end()) scorer_->score(*m, roi->second);
+    rois_.erase(rois_.begin(), rois_.upper_bound(m->sweep_index));
+  }
+  void on_roi(const lcm::ReceiveBuffer*, const std::string&, const trajroi::roi_t* m) { rois_[m->sweep_index] = *m; }
+  void on_status(const lcm::ReceiveBuffer*, const std::string&, const trajroi::status_t* m) {
+    last_ = *m;
+    std::printf("status %6.1f s: sweeps %lld published %lld withheld %lld | kept %lld of %lld | latency p99 %.2f ms | "
+                "drops %lld | pose %s\n",
+                m->uptime_s, static_cast<long long>(m->sweeps), static_cast<long long>(m->sweeps_published),
+                static_cast<long long>(m->sweeps_without_pose), static_cast<long long>(m->points_kept),
+                static_cast<long long>(m->points_in), m->latency_ms_p99, static_cast<long long>(m->ring_drops),
+                m->pose_status.c_str());
+    std::fflush(stdout);
+    if (m->final_status) done_ = true;
+  }
+
+  WatchOptions o_;
+  lcm::LCM lcm_;
+  std::unique_ptr<TruthScorer> scorer_;
+  std::map<std::int64_t, trajroi::roi_t> rois_;
+  std::optional<trajroi::status_t> last_;
+  std::size_t points_heard_ = 0;
+  bool done_ = false;
+};
+
+}  // namespace
+
+void add_watch_command(CLI::App& app) {
+  auto o = std::make_shared<WatchOptions>();
+  CLI::App* cmd = app.add_subcommand("watch", "Listen to trajroid over LCM; score a replayed run against its truth");
+  cmd->add_option("--lcm-url", o->url, "LCM provider URL")->capture_default_str();
+  cmd->add_option("--channel-prefix", o->prefix, "Channels <prefix>_POINTS, _ROI, _STATUS")->capture_default_str();
+  cmd->add_option("--run", o->run_dir, "The run folder being replayed (scores precision and recall)");
+  cmd->add_option("--seconds", o->seconds, "Stop after this long (0: at the daemon's final status)")
+      ->capture_default_str();
+  cmd->callback([o] { Watcher(*o).run(); });
+}
+
+}  // namespace trajroi::cli
