@@ -165,6 +165,9 @@ class Daemon {
   void processing();
   void publishing(lcm::LCM& lcm);
   void recording();
+  void record_to(const fs::path& dir);
+  template <typename T>
+  void record(Ring<T>& ring, const T& item, bool wait_for_room);
   void on_trajectory_message(const lcm::ReceiveBuffer* buffer, const std::string& channel);
   void offer(std::unique_ptr<ActiveTrajectory> trajectory);
   void snapshot(bool final);
@@ -518,12 +521,30 @@ void Daemon::snapshot(bool final) {
   publish_wake_.notify();
 }
 
+template <typename T>
+void Daemon::record(Ring<T>& ring, const T& item, bool wait_for_room) {
+  T* slot = ring.try_claim();
+  while (slot == nullptr && wait_for_room && !stop_.load(std::memory_order_relaxed)) {
+    record_wake_.notify();
+    std::this_thread::sleep_for(std::chrono::microseconds(20));
+    slot = ring.try_claim();
+  }
+  if (slot == nullptr) {
+    ring.count_drop();
+    return;
+  }
+  *slot = item;
+  ring.publish();
+}
+
 void Daemon::processing() {
   if (const std::string w = apply_thread_config("trajroid-proc", config_.realtime.processing); !w.empty()) {
     log::warn("{}", w);
   }
   prefault_stack();
-  RingSink sink(sweeps_, publish_wake_, options_.replay.has_value() && options_.rate == 0.0, stop_);
+  // An as-fast-as-possible replay waits for room downstream: its output is exact.
+  const bool exact = options_.replay.has_value() && options_.rate == 0.0;
+  RingSink sink(sweeps_, publish_wake_, exact, stop_);
   std::int64_t next_status = steady_ns() + kSecond_ns;
   for (;;) {
     processing_beat_.fetch_add(1, std::memory_order_relaxed);
@@ -554,14 +575,7 @@ void Daemon::processing() {
         last_lidar_receive_ns_ = l->receive_ns;
         processor_->lidar_datagram(l->port, std::span<const std::uint8_t>(l->bytes.data(), l->size), l->receive_ns, sink);
         sink.packet_done(steady_ns());
-        if (record_lidar_) {
-          if (LidarItem* r = record_lidar_->try_claim()) {
-            *r = *l;
-            record_lidar_->publish();
-          } else {
-            record_lidar_->count_drop();
-          }
-        }
+        if (record_lidar_) record(*record_lidar_, *l, exact);
         lidar_.release();
       } else {
         const bool is_gnss = gs < ms;
@@ -572,15 +586,7 @@ void Daemon::processing() {
         } else {
           processor_->imu_bytes(bytes, s->receive_ns);
         }
-        Ring<SerialItem>* record = is_gnss ? record_gnss_.get() : record_imu_.get();
-        if (record != nullptr) {
-          if (SerialItem* r = record->try_claim()) {
-            *r = *s;
-            record->publish();
-          } else {
-            record->count_drop();
-          }
-        }
+        if (Ring<SerialItem>* ring = is_gnss ? record_gnss_.get() : record_imu_.get()) record(*ring, *s, exact);
         (is_gnss ? gnss_ : imu_).release();
       }
     }
@@ -762,7 +768,16 @@ void Daemon::publishing(lcm::LCM& lcm) {
 
 void Daemon::recording() {
   pthread_setname_np(pthread_self(), "trajroid-rec");
-  const fs::path& dir = *options_.record;
+  try {
+    record_to(*options_.record);
+  } catch (const std::exception& e) {
+    // The pipeline goes on; what cannot be recorded piles up in the record rings, counted.
+    log::error("--record stopped: {}", e.what());
+  }
+  recording_done_.store(true, std::memory_order_release);
+}
+
+void Daemon::record_to(const fs::path& dir) {
   vlp16::PcapWriter pcap(dir / kLidarFile);
   serial::RecordingWriter gnss((dir / kGnssFile).string());
   serial::RecordingWriter imu((dir / kImuFile).string());
@@ -787,7 +802,6 @@ void Daemon::recording() {
   pcap.close();
   gnss.flush();
   imu.flush();
-  recording_done_.store(true, std::memory_order_release);
 }
 
 // ---- main -----------------------------------------------------------------------------------
@@ -799,11 +813,9 @@ int Daemon::run() {
     log::info("trajectory: {} ({} waypoints, {:.1f} m)", config_.trajectory_file.string(),
               trajectory->trajectory.waypoints().size(), trajectory->trajectory.length_m());
     processor_ = std::make_unique<SweepProcessor>(config_, std::move(trajectory));
-  } catch (const roi::TrajectoryError& e) {
-    log::critical("{}: trajectory.file: {}", config_.file.string(), e.what());
-    return kExitConfig;
-  } catch (const config::ConfigError& e) {
-    log::critical("{}: trajectory.file: {}", config_.file.string(), e.what());
+  } catch (const std::exception& e) {
+    // The trajectory file or the lidar calibration: both part of the configuration.
+    log::critical("{}: {}", config_.file.string(), e.what());
     return kExitConfig;
   }
   try {
