@@ -22,18 +22,6 @@ std::filesystem::path resolve(const std::filesystem::path& base_dir, const std::
   return p.is_absolute() ? p : (base_dir / p).lexically_normal();
 }
 
-double positive(MapReader& m, std::string_view key, double fallback) {
-  const double v = m.number(key, fallback);
-  m.require(v > 0.0, key, "must be > 0");
-  return v;
-}
-
-double non_negative(MapReader& m, std::string_view key, double fallback) {
-  const double v = m.number(key, fallback);
-  m.require(v >= 0.0, key, "must be >= 0");
-  return v;
-}
-
 std::size_t count(MapReader& m, std::string_view key, std::size_t fallback, std::size_t lo, std::size_t hi) {
   const std::int64_t v = m.integer(key, static_cast<std::int64_t>(fallback));
   m.require(v >= static_cast<std::int64_t>(lo) && v <= static_cast<std::int64_t>(hi), key,
@@ -115,8 +103,8 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
     (void)l.choice("model", {"VLP-16"}, "VLP-16");
     c.lidar.calibration = resolve(dir, l.text("calibration", ""));
     if (l.has("mounting")) c.lidar.robot_from_lidar = read_mounting(l.map("mounting"));
-    c.lidar.min_range_m = non_negative(l, "min_range_m", 0.0);
-    c.lidar.max_range_m = positive(l, "max_range_m", 130.0);
+    c.lidar.min_range_m = l.non_negative("min_range_m", 0.0);
+    c.lidar.max_range_m = l.positive("max_range_m", 130.0);
     l.require(c.lidar.max_range_m > c.lidar.min_range_m, "max_range_m", "must exceed min_range_m");
     c.lidar.cut_azimuth_deg = l.number("cut_azimuth_deg", 0.0);
     l.require(c.lidar.cut_azimuth_deg >= 0.0 && c.lidar.cut_azimuth_deg < 360.0, "cut_azimuth_deg",
@@ -152,10 +140,10 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
     c.pose_mode = mode == "per_sweep" ? PoseMode::kPerSweep : PoseMode::kPerFiring;
     c.gate.min_fix_type = static_cast<std::uint8_t>(count(p, "min_fix_type", 3, 1, 5));
     c.gate.require_gnss_fix_ok = p.boolean("require_gnss_fix_ok", true);
-    c.gate.max_h_acc_m = positive(p, "max_h_acc_m", 0.5);
+    c.gate.max_h_acc_m = p.positive("max_h_acc_m", 0.5);
     c.gate.require_rtk_fixed = p.boolean("require_rtk_fixed", false);
-    c.gate.max_extrapolation_ns = std::llround(non_negative(p, "max_extrapolation_s", 0.25) * 1e9);
-    c.gate.max_gap_ns = std::llround(positive(p, "max_gap_s", 1.0) * 1e9);
+    c.gate.max_extrapolation_ns = std::llround(p.non_negative("max_extrapolation_s", 0.25) * 1e9);
+    c.gate.max_gap_ns = std::llround(p.positive("max_gap_s", 1.0) * 1e9);
     c.pose_capacity = count(p, "buffer_samples", 4096, 16, 1U << 20);
     p.finish();
   }
@@ -163,19 +151,19 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
     MapReader o = r.map("roi");
     const std::string shape = o.choice("shape", {"circular", "rectangular"}, "circular");
     c.roi.shape = shape == "rectangular" ? RoiShape::kRectangular : RoiShape::kCircular;
-    c.roi.circle_diameter_m = positive(o, "circle_diameter_m", 28.0);
-    c.roi.rect_height_m = positive(o, "rect_height_m", 12.0);
-    c.roi.rect_width_m = positive(o, "rect_width_m", 28.0);
-    c.roi.spacing_ratio = positive(o, "spacing_ratio", 0.25);
-    c.roi.look_ahead_m = non_negative(o, "look_ahead_m", 42.0);
+    c.roi.circle_diameter_m = o.positive("circle_diameter_m", 28.0);
+    c.roi.rect_height_m = o.positive("rect_height_m", 12.0);
+    c.roi.rect_width_m = o.positive("rect_width_m", 28.0);
+    c.roi.spacing_ratio = o.positive("spacing_ratio", 0.25);
+    c.roi.look_ahead_m = o.non_negative("look_ahead_m", 42.0);
     c.roi.z_min_m = o.number("z_min_m", -std::numeric_limits<double>::infinity());
     c.roi.z_max_m = o.number("z_max_m", std::numeric_limits<double>::infinity());
     o.require(c.roi.z_min_m <= c.roi.z_max_m, "z_max_m", "must be >= z_min_m");
     if (o.has("speed_scaling")) {
       MapReader s = o.map("speed_scaling");
-      c.roi.look_ahead_per_mps_s = non_negative(s, "look_ahead_s", 0.0);
-      c.roi.width_per_mps_s = non_negative(s, "width_s", 0.0);
-      c.roi.max_speed_mps = positive(s, "max_speed_mps", 5.0);
+      c.roi.look_ahead_per_mps_s = s.non_negative("look_ahead_s", 0.0);
+      c.roi.width_per_mps_s = s.non_negative("width_s", 0.0);
+      c.roi.max_speed_mps = s.positive("max_speed_mps", 5.0);
       s.finish();
     }
     const double along = c.roi.shape == RoiShape::kCircular ? c.roi.circle_diameter_m : c.roi.rect_height_m;
@@ -212,7 +200,7 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
   {
     MapReader l = r.map("logging", true);
     c.logging.level = l.choice("level", {"trace", "debug", "info", "warn", "error", "critical", "off"}, "info");
-    c.logging.warning_interval_s = non_negative(l, "warning_interval_s", 5.0);
+    c.logging.warning_interval_s = l.non_negative("warning_interval_s", 5.0);
     l.finish();
   }
   {

@@ -64,6 +64,14 @@ struct StatusSnapshot {
   void add(std::string_view name, std::uint64_t value) noexcept {
     if (counter_count < counters.size()) counters[counter_count++] = {name, value};
   }
+  // Every ring's drops ("ring_drops.*" counters) together.
+  [[nodiscard]] std::uint64_t ring_drops() const noexcept {
+    std::uint64_t drops = 0;
+    for (std::size_t i = 0; i < counter_count; ++i) {
+      if (counters[i].name.starts_with("ring_drops.")) drops += counters[i].value;
+    }
+    return drops;
+  }
 };
 
 template <typename T>

@@ -222,7 +222,7 @@ class Daemon {
   EventFd process_wake_, publish_wake_, record_wake_, main_wake_;
   std::atomic<bool> stop_{false}, reload_{false};
   std::atomic<bool> lidar_done_{false}, gnss_done_{false}, imu_done_{false};
-  std::atomic<bool> processing_done_{false}, publishing_done_{false}, recording_done_{false};
+  std::atomic<bool> processing_done_{false}, publishing_done_{false};
   std::atomic<std::uint64_t> processing_beat_{0}, publishing_beat_{0};
   // CPU time of each kind of thread, added as each ends (for the summary).
   std::atomic<std::int64_t> cpu_sources_ns_{0}, cpu_processing_ns_{0}, cpu_publishing_ns_{0};
@@ -655,11 +655,7 @@ void Daemon::publish_status(lcm::LCM& lcm, const StatusSnapshot& s) {
   m.sweeps_without_pose = static_cast<std::int64_t>(s.processor.sweeps_without_pose);
   m.points_in = static_cast<std::int64_t>(s.processor.points_in);
   m.points_kept = static_cast<std::int64_t>(s.processor.points_kept);
-  std::uint64_t drops = 0;
-  for (std::size_t i = 0; i < s.counter_count; ++i) {
-    if (s.counters[i].name.starts_with("ring_drops.")) drops += s.counters[i].value;
-  }
-  m.ring_drops = static_cast<std::int64_t>(drops);
+  m.ring_drops = static_cast<std::int64_t>(s.ring_drops());
   m.pose_valid = s.pose_valid;
   m.pose_status = std::string(pose::to_string(s.pose_status));
   m.pose_age_s = s.pose_age_s;
@@ -774,7 +770,6 @@ void Daemon::recording() {
     // The pipeline goes on; what cannot be recorded piles up in the record rings, counted.
     log::error("--record stopped: {}", e.what());
   }
-  recording_done_.store(true, std::memory_order_release);
 }
 
 void Daemon::record_to(const fs::path& dir) {
@@ -910,10 +905,7 @@ int Daemon::run() {
   close(sfd);
 
   const StatusSnapshot& s = last_status_;
-  std::uint64_t drops = 0;
-  for (std::size_t i = 0; i < s.counter_count; ++i) {
-    if (s.counters[i].name.starts_with("ring_drops.")) drops += s.counters[i].value;
-  }
+  const std::uint64_t drops = s.ring_drops();
   const double wall_s = static_cast<double>(steady_ns() - start_steady_ns_) * 1e-9;
   log::info("summary: {:.2f} s | sweeps {} published {} withheld (no pose) {} | points in {} kept {} ({:.1f} %) | "
             "latency p50 {:.3f} ms p99 {:.3f} ms over {} sweeps | ring drops {} | lost packets {} | decode errors {}",

@@ -104,6 +104,18 @@ double MapReader::number(std::string_view key) {
 
 double MapReader::number(std::string_view key, double fallback) { return has(key) ? number(key) : fallback; }
 
+double MapReader::positive(std::string_view key, double fallback) {
+  const double v = number(key, fallback);
+  require(v > 0.0, key, "must be > 0");
+  return v;
+}
+
+double MapReader::non_negative(std::string_view key, double fallback) {
+  const double v = number(key, fallback);
+  require(v >= 0.0, key, "must be >= 0");
+  return v;
+}
+
 std::int64_t MapReader::integer(std::string_view key) {
   const std::string text = scalar(key).Scalar();
   std::int64_t value = 0;

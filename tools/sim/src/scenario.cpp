@@ -19,18 +19,6 @@ using config::MapReader;
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 constexpr double kMaxVlp16Range_m = 65535 * vlp16::kDistanceUnit_m;
 
-double positive(MapReader& r, std::string_view key, double fallback) {
-  const double v = r.number(key, fallback);
-  r.require(v > 0.0, key, "must be > 0");
-  return v;
-}
-
-double non_negative(MapReader& r, std::string_view key, double fallback) {
-  const double v = r.number(key, fallback);
-  r.require(v >= 0.0, key, "must be >= 0");
-  return v;
-}
-
 std::uint8_t reflectivity(MapReader& r, std::string_view key, std::uint8_t fallback) {
   const std::int64_t v = r.integer(key, fallback);
   r.require(v >= 0 && v <= 255, key, "must be 0 … 255");
@@ -63,7 +51,7 @@ WorldSpec read_world(MapReader w) {
     box.centre_m = xy(b, "centre");
     box.size_m = xy(b, "size");
     b.require(box.size_m.x() > 0.0 && box.size_m.y() > 0.0, "size", "both sides must be > 0");
-    box.height_m = positive(b, "height", 1.0);
+    box.height_m = b.positive("height", 1.0);
     box.yaw_rad = b.number("yaw_deg", 0.0) * kDegToRad;
     box.reflectivity = reflectivity(b, "reflectivity", 50);
     world.boxes.push_back(box);
@@ -72,8 +60,8 @@ WorldSpec read_world(MapReader w) {
     Cylinder cylinder;
     cylinder.name = c.text("name", "cylinder");
     cylinder.centre_m = xy(c, "centre");
-    cylinder.radius_m = positive(c, "radius", 0.3);
-    cylinder.height_m = positive(c, "height", 1.0);
+    cylinder.radius_m = c.positive("radius", 0.3);
+    cylinder.height_m = c.positive("height", 1.0);
     cylinder.reflectivity = reflectivity(c, "reflectivity", 50);
     world.cylinders.push_back(cylinder);
   });
@@ -89,11 +77,11 @@ PathSpec read_path(MapReader t) {
     PathSegment segment;
     if (s.has("line")) {
       segment.kind = PathSegment::Kind::kLine;
-      segment.length_m = positive(s, "line", 0.0);
+      segment.length_m = s.positive("line", 0.0);
     } else if (s.has("arc")) {
       MapReader arc = s.map("arc");
       segment.kind = PathSegment::Kind::kArc;
-      segment.radius_m = positive(arc, "radius", 0.0);
+      segment.radius_m = arc.positive("radius", 0.0);
       const double turn_deg = arc.number("turn_deg");
       arc.require(turn_deg != 0.0 && std::abs(turn_deg) <= 360.0, "turn_deg", "must be non-zero and within ±360");
       segment.turn_rad = turn_deg * kDegToRad;
@@ -111,10 +99,10 @@ PathSpec read_path(MapReader t) {
 
 RobotSpec read_robot(MapReader r) {
   RobotSpec robot;
-  robot.speed_mps = positive(r, "speed_mps", 0.5);
+  robot.speed_mps = r.positive("speed_mps", 0.5);
   r.require(robot.speed_mps <= 30.0, "speed_mps", "must be at most 30 m/s");
-  robot.wait_before_s = non_negative(r, "wait_before_s", robot.wait_before_s);
-  robot.wait_after_s = non_negative(r, "wait_after_s", robot.wait_after_s);
+  robot.wait_before_s = r.non_negative("wait_before_s", robot.wait_before_s);
+  robot.wait_after_s = r.non_negative("wait_after_s", robot.wait_after_s);
   if (r.has("lidar_mount")) robot.lidar = read_mounting(r.map("lidar_mount"));
   if (r.has("gnss_antenna")) {
     const auto a = r.numbers("gnss_antenna", 3);
@@ -133,11 +121,11 @@ LidarSpec read_lidar(MapReader l) {
   lidar.return_mode = mode == "dual" ? vlp16::ReturnMode::kDual
                       : mode == "last" ? vlp16::ReturnMode::kLast
                                        : vlp16::ReturnMode::kStrongest;
-  lidar.min_range_m = non_negative(l, "min_range_m", lidar.min_range_m);
-  lidar.max_range_m = positive(l, "max_range_m", lidar.max_range_m);
+  lidar.min_range_m = l.non_negative("min_range_m", lidar.min_range_m);
+  lidar.max_range_m = l.positive("max_range_m", lidar.max_range_m);
   l.require(lidar.max_range_m <= kMaxVlp16Range_m, "max_range_m", "must be at most 131.07 m (the packet's 16-bit range)");
   l.require(lidar.max_range_m > lidar.min_range_m, "max_range_m", "must be above min_range_m");
-  lidar.range_noise_m = non_negative(l, "range_noise_m", 0.0);
+  lidar.range_noise_m = l.non_negative("range_noise_m", 0.0);
   lidar.start_azimuth_deg = l.number("start_azimuth_deg", 0.0);
   l.require(lidar.start_azimuth_deg >= 0.0 && lidar.start_azimuth_deg < 360.0, "start_azimuth_deg", "must be in [0, 360)");
   l.finish();
@@ -146,27 +134,27 @@ LidarSpec read_lidar(MapReader l) {
 
 GnssSpec read_gnss(MapReader g) {
   GnssSpec gnss;
-  gnss.rate_hz = positive(g, "rate_hz", gnss.rate_hz);
+  gnss.rate_hz = g.positive("rate_hz", gnss.rate_hz);
   g.require(gnss.rate_hz <= 25.0, "rate_hz", "must be at most 25 Hz");
-  gnss.latency_s = non_negative(g, "latency_s", gnss.latency_s);
+  gnss.latency_s = g.non_negative("latency_s", gnss.latency_s);
   g.require(gnss.latency_s < 1.0, "latency_s", "must be below 1 s");
-  gnss.baud = positive(g, "baud", gnss.baud);
+  gnss.baud = g.positive("baud", gnss.baud);
   g.require(gnss.baud / 10.0 >= static_cast<double>(kGnssEpochBytes) * gnss.rate_hz, "baud",
             "too slow for NAV-HPPOSLLH and NAV-PVT at this rate");
-  gnss.noise_h_m = non_negative(g, "noise_h_m", 0.0);
-  gnss.noise_v_m = non_negative(g, "noise_v_m", 0.0);
-  gnss.correlation_s = positive(g, "correlation_s", gnss.correlation_s);
-  gnss.h_acc_m = positive(g, "h_acc_m", gnss.h_acc_m);
+  gnss.noise_h_m = g.non_negative("noise_h_m", 0.0);
+  gnss.noise_v_m = g.non_negative("noise_v_m", 0.0);
+  gnss.correlation_s = g.positive("correlation_s", gnss.correlation_s);
+  gnss.h_acc_m = g.positive("h_acc_m", gnss.h_acc_m);
   g.each("faults", [&](MapReader& f) {
     GnssFault fault;
     const std::string kind = f.choice("kind", {"lost", "no_rtk", "float"}, "lost");
     fault.kind = kind == "lost" ? GnssFault::Kind::kLost : kind == "float" ? GnssFault::Kind::kFloat : GnssFault::Kind::kNoRtk;
-    fault.from_s = non_negative(f, "from_s", 0.0);
+    fault.from_s = f.non_negative("from_s", 0.0);
     fault.to_s = f.number("to_s");
     f.require(fault.to_s > fault.from_s, "to_s", "must be after from_s");
     const double default_noise = fault.kind == GnssFault::Kind::kFloat ? 0.15 : 1.0;
-    fault.noise_m = non_negative(f, "noise_m", fault.kind == GnssFault::Kind::kLost ? 0.0 : default_noise);
-    fault.h_acc_m = positive(f, "h_acc_m", fault.kind == GnssFault::Kind::kLost ? 50.0 : 2.0 * default_noise);
+    fault.noise_m = f.non_negative("noise_m", fault.kind == GnssFault::Kind::kLost ? 0.0 : default_noise);
+    fault.h_acc_m = f.positive("h_acc_m", fault.kind == GnssFault::Kind::kLost ? 50.0 : 2.0 * default_noise);
     gnss.faults.push_back(fault);
   });
   g.finish();
@@ -178,13 +166,13 @@ ImuSpec read_imu(MapReader i) {
   const std::int64_t divisor = i.integer("rate_divisor", imu.rate_divisor);
   i.require(divisor >= 1 && divisor <= 800, "rate_divisor", "must be 1 … 800 (800 Hz / divisor)");
   imu.rate_divisor = static_cast<int>(divisor);
-  imu.latency_s = non_negative(i, "latency_s", 0.0);
+  imu.latency_s = i.non_negative("latency_s", 0.0);
   i.require(imu.latency_s < 1.0, "latency_s", "must be below 1 s");
-  imu.baud = positive(i, "baud", imu.baud);
+  imu.baud = i.positive("baud", imu.baud);
   i.require(imu.baud / 10.0 >= static_cast<double>(kImuFrameBytes) * 800.0 / imu.rate_divisor, "baud", "too slow for this output rate");
-  imu.angle_noise_deg = non_negative(i, "angle_noise_deg", 0.0);
-  imu.gyro_noise_rps = non_negative(i, "gyro_noise_rps", 0.0);
-  imu.accel_noise_mps2 = non_negative(i, "accel_noise_mps2", 0.0);
+  imu.angle_noise_deg = i.non_negative("angle_noise_deg", 0.0);
+  imu.gyro_noise_rps = i.non_negative("gyro_noise_rps", 0.0);
+  imu.accel_noise_mps2 = i.non_negative("accel_noise_mps2", 0.0);
   imu.heading_bias_deg = i.number("heading_bias_deg", 0.0);
   i.require(std::abs(imu.heading_bias_deg) <= 180.0, "heading_bias_deg", "must be within ±180");
   imu.magnetic_declination_deg = i.number("magnetic_declination_deg", 0.0);
@@ -195,14 +183,14 @@ ImuSpec read_imu(MapReader i) {
 
 EvaluationSpec read_evaluation(MapReader e) {
   EvaluationSpec ev;
-  ev.circle_diameter_m = positive(e, "circle_diameter_m", ev.circle_diameter_m);
-  ev.rect_height_m = positive(e, "rect_height_m", ev.rect_height_m);
-  ev.rect_width_m = positive(e, "rect_width_m", ev.rect_width_m);
-  ev.look_ahead_m = positive(e, "look_ahead_m", ev.look_ahead_m);
-  ev.corridor_width_m = positive(e, "corridor_width_m", ev.corridor_width_m);
-  ev.cuboid_length_m = positive(e, "cuboid_length_m", ev.cuboid_length_m);
-  ev.cuboid_width_m = positive(e, "cuboid_width_m", ev.cuboid_width_m);
-  ev.cuboid_height_m = positive(e, "cuboid_height_m", ev.cuboid_height_m);
+  ev.circle_diameter_m = e.positive("circle_diameter_m", ev.circle_diameter_m);
+  ev.rect_height_m = e.positive("rect_height_m", ev.rect_height_m);
+  ev.rect_width_m = e.positive("rect_width_m", ev.rect_width_m);
+  ev.look_ahead_m = e.positive("look_ahead_m", ev.look_ahead_m);
+  ev.corridor_width_m = e.positive("corridor_width_m", ev.corridor_width_m);
+  ev.cuboid_length_m = e.positive("cuboid_length_m", ev.cuboid_length_m);
+  ev.cuboid_width_m = e.positive("cuboid_width_m", ev.cuboid_width_m);
+  ev.cuboid_height_m = e.positive("cuboid_height_m", ev.cuboid_height_m);
   e.each("keyframes", [&](MapReader& k) {
     Keyframe keyframe;
     keyframe.name = k.text("name");

@@ -42,6 +42,9 @@ class MapReader {
 
   [[nodiscard]] double number(std::string_view key);                 // required
   [[nodiscard]] double number(std::string_view key, double fallback);
+  // A number that must be > 0 / ≥ 0 (checked, "must be > 0" / "must be >= 0").
+  [[nodiscard]] double positive(std::string_view key, double fallback);
+  [[nodiscard]] double non_negative(std::string_view key, double fallback);
   [[nodiscard]] std::int64_t integer(std::string_view key);
   [[nodiscard]] std::int64_t integer(std::string_view key, std::int64_t fallback);
   [[nodiscard]] std::string text(std::string_view key);
