@@ -23,7 +23,6 @@ trajroi::trajectory_t trajectory(std::int32_t id, std::vector<double> u, std::ve
 }
 
 TEST(TrajroidControl, TrajectoryOverLcmSighupAndSigterm) {
-  TRAJROI_SKIP_LCM_LISTENER_UNDER_ASAN();
   const std::string prefix = "TRJTEST_" + std::to_string(::getpid()) + "_CONTROL";
   const fs::path run = corridor_run();
   std::string text = slurp(run / "trajroid.yaml");

@@ -25,6 +25,7 @@
 #include "trajroi/pose_t.hpp"
 #include "trajroi/roi_t.hpp"
 #include "trajroi/status_t.hpp"
+#include "trajroi/transport/lcm_subscribe.hpp"
 #include "trajroi/trajectory_t.hpp"
 
 namespace daemon_test {
@@ -104,26 +105,14 @@ class Child {
   bool exited_ = false;
 };
 
-// Under the ASan preset (TRAJROI_SANITIZER=asan) liblcm 1.3.1, which is not instrumented, hands
-// the instrumented subscription callback a corrupted subscription pointer (UBSan: misaligned
-// member access in lcm-cpp-impl.hpp:88, reproducible); until that is understood, the tests
-// that listen over LCM run in the release pass only. trajroid itself still runs under ASan in
-// the recording and lcm-spy tests.
-#define TRAJROI_SKIP_LCM_LISTENER_UNDER_ASAN()                                                              \
-  do {                                                                                                   \
-    if (const char* s = std::getenv("TRAJROI_SANITIZER"); s != nullptr && std::string(s) == "asan") {       \
-      GTEST_SKIP() << "LCM listener tests run in the release pass (liblcm 1.3.1 under ASan: see fixture)"; \
-    }                                                                                                    \
-  } while (false)
-
 // Everything trajroid publishes on a test's channels.
 class Listener {
  public:
   explicit Listener(const std::string& prefix) : prefix_(prefix), lcm_(kTestLcmUrl) {
-    lcm_.subscribe(prefix + "_POINTS", &Listener::on_points, this);
-    lcm_.subscribe(prefix + "_POSE", &Listener::on_pose, this);
-    lcm_.subscribe(prefix + "_ROI", &Listener::on_roi, this);
-    lcm_.subscribe(prefix + "_STATUS", &Listener::on_status, this);
+    trajroi::transport::subscribe<&Listener::on_points>(lcm_, prefix + "_POINTS", this);
+    trajroi::transport::subscribe<&Listener::on_pose>(lcm_, prefix + "_POSE", this);
+    trajroi::transport::subscribe<&Listener::on_roi>(lcm_, prefix + "_ROI", this);
+    trajroi::transport::subscribe<&Listener::on_status>(lcm_, prefix + "_STATUS", this);
     thread_ = std::thread([this] {
       while (!stop_) lcm_.handleTimeout(20);
     });

@@ -21,6 +21,7 @@
 #include "trajroi/roi_t.hpp"
 #include "trajroi/sim/run_folder.hpp"
 #include "trajroi/status_t.hpp"
+#include "trajroi/transport/lcm_subscribe.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
 #include "trajroi/vlp16/stream_decoder.hpp"
 
@@ -122,9 +123,9 @@ class Watcher {
   explicit Watcher(const WatchOptions& o) : o_(o), lcm_(o.url) {
     if (!lcm_.good()) throw std::runtime_error("LCM: cannot open '" + o.url + "'");
     if (!o.run_dir.empty()) scorer_ = std::make_unique<TruthScorer>(o.run_dir);
-    lcm_.subscribe(o.prefix + "_POINTS", &Watcher::on_points, this);
-    lcm_.subscribe(o.prefix + "_ROI", &Watcher::on_roi, this);
-    lcm_.subscribe(o.prefix + "_STATUS", &Watcher::on_status, this);
+    trajroi::transport::subscribe<&Watcher::on_points>(lcm_, o.prefix + "_POINTS", this);
+    trajroi::transport::subscribe<&Watcher::on_roi>(lcm_, o.prefix + "_ROI", this);
+    trajroi::transport::subscribe<&Watcher::on_status>(lcm_, o.prefix + "_STATUS", this);
   }
 
   void run() {
