@@ -1,5 +1,6 @@
 #include "trajroi/daemon/sweep_processor.hpp"
 
+#include <array>
 #include <algorithm>
 #include <fstream>
 #include <limits>
@@ -12,7 +13,10 @@ namespace trajroi::daemon {
 namespace {
 
 constexpr std::size_t kScratchPoints = 1024;       // more than one packet's 384 points
-constexpr std::int64_t kSpeedBaseline_ns = 500'000'000;
+// The speed is the distance to the pose this long before, over the time. The pose must have
+// been valid at every sweep start since then: right after a gap in the pose (a GNSS outage)
+// the shorter baselines are tried, and in the first 0.1 s none (the speed is unknown).
+constexpr std::array<std::int64_t, 3> kSpeedBaselines_ns{500'000'000, 200'000'000, 100'000'000};
 constexpr double kMaxAdvancePerSweep_m = 10.0;    // projection search window (50 m/s at 5 Hz)
 
 vlp16::Calibration load_calibration(const std::filesystem::path& file) {
@@ -170,15 +174,24 @@ void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
   s.filtered = q.valid();
   if (!s.filtered) {
     have_hint_ = false;
+    valid_since_ns_.reset();
     return;
   }
   s.robot = PublishedPose::from(q.global_from_robot);
   s.sensor = PublishedPose::from(s.robot.isometry() * config_.lidar.robot_from_lidar);
   sweep_sensor_pose_ = s.sensor.isometry();
   const Eigen::Vector2d position = q.global_from_robot.translation().head<2>();
-  const pose::PoseQuery before = poses_.pose_at(frame.start_time_ns - kSpeedBaseline_ns);
-  if (before.valid()) {
-    s.speed_mps = (position - before.global_from_robot.translation().head<2>()).norm() / (kSpeedBaseline_ns * 1e-9);
+  s.speed_known = false;
+  if (!valid_since_ns_) valid_since_ns_ = frame.start_time_ns;
+  for (const std::int64_t baseline : kSpeedBaselines_ns) {
+    if (frame.start_time_ns - baseline < *valid_since_ns_) continue;
+    const pose::PoseQuery before = poses_.pose_at(frame.start_time_ns - baseline);
+    if (before.valid()) {
+      s.speed_mps = (position - before.global_from_robot.translation().head<2>()).norm() /
+                    (static_cast<double>(baseline) * 1e-9);
+      s.speed_known = true;
+      break;
+    }
   }
 
   const roi::Trajectory& trajectory = active_->trajectory;
@@ -186,7 +199,8 @@ void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
                                        : trajectory.project(position);
   s_hint_m_ = p.s_m;
   have_hint_ = true;
-  const double speed = std::min(s.speed_mps, r.max_speed_mps);
+  // An unknown speed grows the ROI as the cap does: the larger region is the safe side.
+  const double speed = s.speed_known ? std::min(s.speed_mps, r.max_speed_mps) : r.max_speed_mps;
   s.start_s_m = p.s_m;
   s.look_ahead_m = r.look_ahead_m + speed * r.look_ahead_per_mps_s;
   const double grow = speed * r.width_per_mps_s;

@@ -19,6 +19,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -68,7 +69,8 @@ struct Sweep {
   PublishedPose robot;                  // global_from_robot at the start
   PublishedPose sensor;                 // global_from_lidar at the start (used for the whole
                                         // sweep in per-sweep mode)
-  double speed_mps = 0.0;
+  double speed_mps = 0.0;               // over the last 0.5 s (0.2 s, 0.1 s after a pose gap)
+  bool speed_known = false;             // false: the pose valid for less than 0.1 s (speed_mps 0)
   pose::FixQuality fix;                 // newest fix at the sweep's start
   std::int64_t fix_t_ns = 0;            // its time (0: none)
 
@@ -160,6 +162,7 @@ class SweepProcessor {
   std::unique_ptr<ActiveTrajectory> retired_;
   double s_hint_m_ = 0.0;
   bool have_hint_ = false;
+  std::optional<std::int64_t> valid_since_ns_;  // first sweep start of the current valid run
 
   roi::CircularRoiSet circles_;
   roi::RectangularRoiSet rects_;

@@ -1,0 +1,200 @@
+// SweepProcessor driven in process with the test scenario's recordings, merged by receive
+// time as trajroid's replay merges them: the speed growth of the ROI, the trajectory swap at
+// a sweep boundary, the pose gate without GNSS.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "daemon_fixture.hpp"
+#include "trajroi/daemon/config.hpp"
+#include "trajroi/daemon/sweep_processor.hpp"
+#include "trajroi/roi/trajectory.hpp"
+#include "trajroi/serial/byte_log.hpp"
+#include "trajroi/vlp16/pcap_source.hpp"
+
+namespace {
+
+using namespace daemon_test;
+using trajroi::daemon::ActiveTrajectory;
+using trajroi::daemon::DaemonConfig;
+using trajroi::daemon::LidarPort;
+using trajroi::daemon::Sweep;
+using trajroi::daemon::SweepProcessor;
+
+struct Event {
+  enum Kind { kLidar, kGnss, kImu } kind;
+  LidarPort port = LidarPort::kData;
+  std::int64_t t_ns = 0;
+  std::vector<std::uint8_t> bytes;
+};
+
+// Every input of the run, in receive-time order (GNSS before IMU before lidar on a tie, as
+// trajroid's replay).
+const std::vector<Event>& run_events() {
+  static const std::vector<Event> events = [] {
+    std::vector<Event> out;
+    trajroi::vlp16::PcapSource pcap(corridor_run() / "lidar.pcap");
+    trajroi::vlp16::Datagram d;
+    while (pcap.next(d) == trajroi::vlp16::PacketSource::Next::kDatagram) {
+      out.push_back({Event::kLidar,
+                     d.destination_port == trajroi::vlp16::kPositionPort ? LidarPort::kPosition : LidarPort::kData,
+                     d.receive_time_ns, std::vector<std::uint8_t>(d.payload.begin(), d.payload.end())});
+    }
+    for (const auto& [kind, name] : {std::pair{Event::kGnss, "gnss.trjb"}, std::pair{Event::kImu, "imu.trjb"}}) {
+      trajroi::serial::ReplaySource source((corridor_run() / name).string());
+      trajroi::serial::Chunk chunk;
+      while (source.read(chunk, std::chrono::milliseconds(0)) == trajroi::serial::ReadStatus::kData) {
+        out.push_back({kind, LidarPort::kData, chunk.receive_time_ns,
+                       std::vector<std::uint8_t>(chunk.bytes.begin(), chunk.bytes.end())});
+      }
+    }
+    std::stable_sort(out.begin(), out.end(), [](const Event& a, const Event& b) {
+      return a.t_ns != b.t_ns ? a.t_ns < b.t_ns : static_cast<int>(a.kind) > static_cast<int>(b.kind);
+    });
+    return out;
+  }();
+  return events;
+}
+
+DaemonConfig run_config() { return trajroi::daemon::load_daemon_config(corridor_run() / "trajroid.yaml"); }
+
+std::unique_ptr<ActiveTrajectory> trajectory_from(const fs::path& file, std::int32_t id) {
+  return std::make_unique<ActiveTrajectory>(ActiveTrajectory{trajroi::roi::parse_trajectory_csv(slurp(file), file.string()), id});
+}
+
+struct Collect final : trajroi::daemon::SweepSink {
+  std::vector<Sweep> sweeps;
+  void on_sweep(const Sweep& s) override { sweeps.push_back(s); }
+};
+
+// Feeds the run; `before_lidar(processor, sink)` runs before each lidar datagram. `with_gnss`
+// false leaves the GNSS stream out.
+template <typename Hook>
+Collect drive(const DaemonConfig& config, SweepProcessor& processor, bool with_gnss, Hook before_lidar) {
+  Collect sink;
+  for (const Event& e : run_events()) {
+    if (e.kind == Event::kGnss) {
+      if (with_gnss) processor.gnss_bytes(e.bytes, e.t_ns);
+    } else if (e.kind == Event::kImu) {
+      processor.imu_bytes(e.bytes, e.t_ns);
+    } else {
+      before_lidar(processor, sink);
+      processor.lidar_datagram(e.port, e.bytes, e.t_ns, sink);
+    }
+  }
+  processor.flush(sink);
+  (void)config;
+  return sink;
+}
+
+Collect drive(const DaemonConfig& config, SweepProcessor& processor, bool with_gnss = true) {
+  return drive(config, processor, with_gnss, [](SweepProcessor&, Collect&) {});
+}
+
+TEST(SweepProcessor, TheRoiGrowsWithSpeedAndTheGrowthIsCapped) {
+  DaemonConfig config = run_config();
+  config.roi.look_ahead_per_mps_s = 3.0;
+  config.roi.width_per_mps_s = 2.0;
+  config.roi.max_speed_mps = 5.0;
+  SweepProcessor grown(config, trajectory_from(config.trajectory_file, 0));
+  const Collect free_run = drive(config, grown);
+
+  DaemonConfig capped_config = config;
+  capped_config.roi.max_speed_mps = 0.5;
+  SweepProcessor capped(capped_config, trajectory_from(config.trajectory_file, 0));
+  const Collect capped_run = drive(capped_config, capped);
+  ASSERT_EQ(free_run.sweeps.size(), capped_run.sweeps.size());
+
+  const auto& r = config.roi;
+  int cruising = 0, unknown = 0;
+  for (std::size_t k = 0; k < free_run.sweeps.size(); ++k) {
+    const Sweep& s = free_run.sweeps[k];
+    if (!s.filtered) continue;
+    // The formula, sweep by sweep, with the speed the sweep reports.
+    const double v = s.speed_known ? std::min(s.speed_mps, r.max_speed_mps) : r.max_speed_mps;
+    EXPECT_DOUBLE_EQ(s.look_ahead_m, r.look_ahead_m + 3.0 * v) << k;
+    EXPECT_DOUBLE_EQ(s.radius_m, (r.circle_diameter_m + 2.0 * v) / 2.0) << k;
+    const Sweep& c = capped_run.sweeps[k];
+    ASSERT_TRUE(c.filtered);
+    ASSERT_EQ(c.speed_known, s.speed_known);
+    const double vc = c.speed_known ? std::min(c.speed_mps, 0.5) : 0.5;
+    EXPECT_DOUBLE_EQ(c.look_ahead_m, r.look_ahead_m + 3.0 * vc) << k;
+    EXPECT_LE(c.look_ahead_m, r.look_ahead_m + 1.5 + 1e-12);
+    // While the robot cruises (1 m/s in the scenario from about 2 s to 28 s; sweeps are
+    // 0.1 s), the estimated speed says so and the capped run is at its cap.
+    if (!s.speed_known) {
+      ++unknown;
+      continue;
+    }
+    if (k >= 30 && k + 30 < free_run.sweeps.size()) {
+      ++cruising;
+      EXPECT_NEAR(s.speed_mps, 1.0, 0.1) << "sweep " << k;
+      EXPECT_DOUBLE_EQ(c.look_ahead_m, r.look_ahead_m + 1.5) << k;
+    }
+  }
+  EXPECT_GT(cruising, 150) << "the scenario drives 12 + 4.7 + 10 m at 1 m/s";
+  EXPECT_LE(unknown, 2) << "the first sweep with a pose, and the first after the GNSS outage";
+}
+
+TEST(SweepProcessor, ATrajectoryOfferedInsideASweepTakesEffectAtTheNextOne) {
+  const DaemonConfig config = run_config();
+  SweepProcessor processor(config, trajectory_from(config.trajectory_file, 0));
+  // A path 1 m beside the configured one, offered in the middle of the 60th sweep.
+  const fs::path shifted = fs::temp_directory_path() / ("shifted_" + std::to_string(::getpid()) + ".csv");
+  {
+    const trajroi::roi::Trajectory original = trajectory_from(config.trajectory_file, 0)->trajectory;
+    std::FILE* f = std::fopen(shifted.c_str(), "w");
+    for (const auto& p : original.waypoints()) std::fprintf(f, "%.17g,%.17g\n", p.x(), p.y() + 1.0);
+    std::fclose(f);
+  }
+  std::size_t offered_during = 0;
+  std::size_t datagrams_in_sweep = 0;
+  std::uint64_t last_index = 0;
+  bool offered = false;
+  const Collect run = drive(config, processor, true, [&](SweepProcessor& p, Collect& sink) {
+    if (p.current().index != last_index) {
+      last_index = p.current().index;
+      datagrams_in_sweep = 0;
+    }
+    if (!offered && sink.sweeps.size() == 60 && ++datagrams_in_sweep == 40) {
+      p.offer_trajectory(trajectory_from(shifted, 9));
+      offered = true;
+      offered_during = sink.sweeps.size();
+    }
+  });
+  fs::remove(shifted);
+  ASSERT_TRUE(offered);
+  ASSERT_GT(run.sweeps.size(), offered_during + 1);
+  EXPECT_EQ(run.sweeps[offered_during].trajectory_id, 0) << "the sweep in progress keeps its trajectory";
+  EXPECT_EQ(run.sweeps[offered_during + 1].trajectory_id, 9);
+  EXPECT_EQ(processor.active_trajectory_id(), 9);
+  EXPECT_EQ(processor.counters().trajectory_swaps, 1u);
+  ASSERT_NE(processor.take_retired(), nullptr) << "the old trajectory is handed back, not freed in the loop";
+  // The new chain lies on the new path: 1 m beside the old centres.
+  const Sweep& before = run.sweeps[offered_during];
+  const Sweep& after = run.sweeps[offered_during + 1];
+  ASSERT_TRUE(before.filtered && after.filtered);
+  ASSERT_FALSE(before.centres.empty());
+  ASSERT_FALSE(after.centres.empty());
+  EXPECT_NEAR(after.centres.front().position.y() - before.centres.front().position.y(), 1.0, 0.2);
+  for (std::size_t k = offered_during + 1; k < run.sweeps.size(); ++k) EXPECT_EQ(run.sweeps[k].trajectory_id, 9) << k;
+}
+
+TEST(SweepProcessor, WithoutGnssNoSweepIsFilteredAndEachSaysWhy) {
+  const DaemonConfig config = run_config();
+  SweepProcessor processor(config, trajectory_from(config.trajectory_file, 0));
+  const Collect run = drive(config, processor, false);
+  ASSERT_GT(run.sweeps.size(), 200u);
+  for (const Sweep& s : run.sweeps) {
+    EXPECT_FALSE(s.filtered);
+    EXPECT_EQ(s.pose_status, trajroi::pose::PoseStatus::kNoGnss);
+    EXPECT_EQ(s.size(), 0u) << "no point leaves without a pose";
+    EXPECT_GT(s.points_in, 0u);
+  }
+  EXPECT_EQ(processor.counters().sweeps_without_pose, run.sweeps.size());
+  EXPECT_EQ(processor.counters().sweeps_filtered, 0u);
+}
+
+}  // namespace
