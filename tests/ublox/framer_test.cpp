@@ -276,6 +276,16 @@ TEST(UbxMessages, NavPvtUtcNeedsTheFlagsAndARealDate) {
   p[6] = 2;
   p[7] = 30;  // February 30th
   EXPECT_FALSE(decode_nav_pvt(p).value.utc_valid());
+  // Year 65535 (the field's maximum) is a real date but past int64 nanoseconds (the overflow
+  // the scenario fuzz target found in the shared UTC conversion): not valid UTC, and utc_ns()
+  // is defined.
+  p[7] = 28;
+  p[4] = 0xFF;
+  p[5] = 0xFF;
+  m = decode_nav_pvt(p).value;
+  EXPECT_TRUE(m.date().ok());
+  EXPECT_FALSE(m.utc_valid());
+  EXPECT_EQ(m.utc_ns(), std::numeric_limits<std::int64_t>::min()) << "the documented earliest time, no overflow";
 }
 
 TEST(UbxNames, KnownAndUnknownMessages) {

@@ -82,7 +82,8 @@ void PoseInput::on_vn100(const vn100::Sample& s, std::int64_t receive_ns) {
     return;
   }
   const Eigen::Quaterniond local =
-      pose::enu_from_vn_ypr(s.ypr_deg[0], s.ypr_deg[1], s.ypr_deg[2], config_.imu);
+      pose::enu_from_vn_ypr(static_cast<double>(s.ypr_deg[0]), static_cast<double>(s.ypr_deg[1]),
+                            static_cast<double>(s.ypr_deg[2]), config_.imu);
   // The attitude is relative to local north at the robot; turn it into the global frame's
   // axes (UTM convergence, or the small tilt of LocalCartesian away from its origin).
   const pose::Geodetic where = last_position_.value_or(frame_.to_geodetic(Eigen::Vector3d::Zero()));

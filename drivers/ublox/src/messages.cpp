@@ -1,6 +1,7 @@
 #include "trajroi/ublox/messages.hpp"
 
 #include <bit>
+#include <limits>
 
 #include "trajroi/framing/little_endian.hpp"
 #include "trajroi/ublox/config.hpp"
@@ -57,7 +58,7 @@ FixType NavPvt::fix_type() const noexcept {
 }
 
 bool NavPvt::utc_valid() const noexcept {
-  return valid_date && valid_time && date().ok() && hour < 24 && minute < 60 && second <= 60;
+  return valid_date && valid_time && utc_representable(date()) && hour < 24 && minute < 60 && second <= 60;
 }
 
 std::chrono::year_month_day NavPvt::date() const noexcept {
@@ -65,7 +66,8 @@ std::chrono::year_month_day NavPvt::date() const noexcept {
 }
 
 std::int64_t NavPvt::utc_ns() const noexcept {
-  return utc_ns_from_civil(date(), hour * 3'600 + minute * 60 + second) + nano_ns;
+  const std::int64_t second_ns = utc_ns_from_civil(date(), hour * 3'600 + minute * 60 + second);
+  return second_ns == std::numeric_limits<std::int64_t>::min() ? second_ns : second_ns + nano_ns;
 }
 
 Decoded<NavPvt> decode_nav_pvt(std::span<const std::uint8_t> p) noexcept {

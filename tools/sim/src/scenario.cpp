@@ -235,7 +235,7 @@ bool parse_utc_iso8601(std::string_view text, std::int64_t& utc_ns) {
   }
   const std::chrono::year_month_day ymd{std::chrono::year{year}, std::chrono::month{static_cast<unsigned>(month)},
                                         std::chrono::day{static_cast<unsigned>(day)}};
-  if (!ymd.ok()) return false;
+  if (!utc_representable(ymd)) return false;
   utc_ns = utc_ns_from_civil(ymd, hour * 3600 + minute * 60 + second) + fraction_ns;
   return true;
 }

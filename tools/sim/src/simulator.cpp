@@ -343,7 +343,7 @@ void Simulator::Impl::run_imu(SimulationSink& sink, SimulationStats& stats) cons
     sample.set(vn100::Field::kAngularRate);
     sample.set(vn100::Field::kAccel);
     sample.time_startup_ns = static_cast<std::uint64_t>(scenario.start_utc_ns + t - boot_utc_ns);
-    sample.ypr_deg = {static_cast<float>(wrap_deg(noisy(magnetic_yaw, imu.angle_noise_deg))),
+    sample.ypr_deg = {static_cast<float>(wrap_deg(static_cast<double>(noisy(magnetic_yaw, imu.angle_noise_deg)))),
                       noisy(0.0, imu.angle_noise_deg), noisy(0.0, imu.angle_noise_deg)};
     // Body FRD: a left turn (counter-clockwise, ω > 0) is a negative rate about z-down, and
     // its centripetal acceleration v·ω points left (−y); at rest the specific force is −g.

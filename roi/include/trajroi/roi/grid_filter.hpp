@@ -41,7 +41,7 @@ struct FloatZLimits {
   bool limited;
 };
 [[nodiscard]] inline FloatZLimits float_z_limits(const ZLimits& z) noexcept {
-  constexpr double kMax = std::numeric_limits<float>::max();
+  constexpr auto kMax = static_cast<double>(std::numeric_limits<float>::max());
   return {float_at_or_above(std::max(z.min_m, -kMax)), float_at_or_below(std::min(z.max_m, kMax)),
           std::isfinite(z.min_m) || std::isfinite(z.max_m)};
 }
@@ -313,9 +313,9 @@ template <typename RoiSet>
 template <typename Point>
 void GridFilter<RoiSet>::scalar_point(std::span<const Point> points, std::size_t i,
                                       Scan& scan) const {
-  const double x = points[i].x;
-  const double y = points[i].y;
-  const double z = points[i].z;
+  const auto x = static_cast<double>(points[i].x);
+  const auto y = static_cast<double>(points[i].y);
+  const auto z = static_cast<double>(points[i].z);
   const ZLimits& z_limits = rois_->z_limits();
   const Precheck pre = precheck(z_limits, x, y, z);
   if (pre != Precheck::kPass) [[unlikely]] {
@@ -419,7 +419,7 @@ std::size_t GridFilter<RoiSet>::scan_sse2(std::span<const PointXYZI> points, Sca
       const std::uint32_t c[4] = {c0, c1, c2, c3};
       for (std::size_t k = 0; k < 4; ++k) {
         out[count] = static_cast<std::uint32_t>(i + k);
-        count += decide(c[k], points[i + k].x, points[i + k].y);
+        count += decide(c[k], static_cast<double>(points[i + k].x), static_cast<double>(points[i + k].y));
       }
       continue;
     }
@@ -564,7 +564,8 @@ __attribute__((target("avx2,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx2
     }
     for (std::size_t k = 0; k < 8; ++k) {
       out[count] = static_cast<std::uint32_t>(first + k);
-      count += decide(cell_value[k], points[first + k].x, points[first + k].y);
+      count += decide(cell_value[k], static_cast<double>(points[first + k].x),
+                      static_cast<double>(points[first + k].y));
     }
   };
   auto finish = [&](std::size_t first, const detail::Avx2Block& block) __attribute__((target("avx2,popcnt"))) {

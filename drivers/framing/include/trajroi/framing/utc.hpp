@@ -6,13 +6,24 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 namespace trajroi {
 
-// ns since 1970-01-01T00:00:00Z of `date` plus `second_of_day` seconds. `date` must be ok().
+// Dates whose UTC time fits int64 nanoseconds (±292 years around 1970), with a day's margin.
+[[nodiscard]] inline bool utc_representable(const std::chrono::year_month_day& date) noexcept {
+  return date.ok() && date.year() >= std::chrono::year{1678} && date.year() <= std::chrono::year{2261};
+}
+
+// ns since 1970-01-01T00:00:00Z of `date` plus `second_of_day` (0 … 86 400) seconds. `date`
+// must be utc_representable(); one that is not (a wire value such as UBX's year 65535) gives
+// the earliest time, never an overflow.
 [[nodiscard]] inline std::int64_t utc_ns_from_civil(const std::chrono::year_month_day& date,
                                                     std::int64_t second_of_day) noexcept {
+  if (!utc_representable(date) || second_of_day < 0 || second_of_day > 86'400) {
+    return std::numeric_limits<std::int64_t>::min();
+  }
   const std::int64_t days = std::chrono::sys_days{date}.time_since_epoch().count();
   return (days * 86'400 + second_of_day) * 1'000'000'000;
 }
