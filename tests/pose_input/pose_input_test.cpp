@@ -108,5 +108,20 @@ TEST_F(PoseInputTest, InvalidPositionKeepsTheLastOneWithItsFailingQuality) {
   EXPECT_EQ(input_.gnss_framing().checksum_errors, 0u);
 }
 
+// Found by the ubx fuzz target: a well-framed NAV-PVT whose latitude is −133.8° made the
+// global-frame conversion throw out of the processing thread. It is counted and dropped, and
+// the fixes around it still count.
+TEST_F(PoseInputTest, APositionOffTheEllipsoidIsCountedNotThrown) {
+  input_.gnss_bytes(ublox::encode_nav_pvt(pvt(1000, 36.0, 127.0)), 1'030'000'000);
+  input_.gnss_bytes(ublox::encode_nav_pvt(pvt(1125, -133.791587, -40.86282)), 1'155'000'000);
+  input_.gnss_bytes(ublox::encode_nav_pvt(pvt(1250, 36.0, 200.0)), 1'280'000'000);
+  input_.gnss_bytes(ublox::encode_nav_pvt(pvt(1375, 36.00001, 127.0)), 1'405'000'000);
+  EXPECT_EQ(input_.counters().invalid_position, 2u);
+  EXPECT_EQ(input_.counters().fixes, 2u);
+  const pose::GnssFix* newest = buffer_.newest_fix();
+  ASSERT_NE(newest, nullptr);
+  EXPECT_NEAR(newest->antenna_global_m.y(), 1.11, 0.01) << "0.00001° north of the origin";
+}
+
 }  // namespace
 }  // namespace trajroi::pose_input

@@ -62,12 +62,23 @@ void PoseInput::on_ubx(const ublox::Message& m, std::int64_t receive_ns) {
   if (pvt.invalid_llh) {
     ++counters_.invalid_position;
     if (!last_position_) return;
+    fix.antenna_global_m = *last_global_;
   } else {
-    last_position_ = hp ? pose::Geodetic{hp_->lat_deg(), hp_->lon_deg(), hp_->height_m()}
-                        : pose::Geodetic{pvt.lat_deg(), pvt.lon_deg(), pvt.height_m()};
+    const pose::Geodetic position = hp ? pose::Geodetic{hp_->lat_deg(), hp_->lon_deg(), hp_->height_m()}
+                                       : pose::Geodetic{pvt.lat_deg(), pvt.lon_deg(), pvt.height_m()};
+    // A position off the ellipsoid's range (a corrupt frame whose checksum happened to
+    // match), or one the global frame cannot express (far outside a fixed UTM zone), is
+    // counted and dropped; the conversion's exception must not reach the processing thread.
+    try {
+      fix.antenna_global_m = frame_.to_global(position);
+    } catch (const std::exception&) {
+      ++counters_.invalid_position;
+      return;
+    }
+    last_position_ = position;
+    last_global_ = fix.antenna_global_m;
     if (hp) ++counters_.high_precision;
   }
-  fix.antenna_global_m = frame_.to_global(*last_position_);
   fix.t_ns = gnss_clock_.map(std::int64_t{pvt.itow_ms} * 1'000'000, receive_ns) - config_.gnss_delay_ns;
   if (buffer_.add_fix(fix)) {
     ++counters_.fixes;

@@ -53,7 +53,7 @@ struct PoseInputConfig {
 struct PoseInputCounters {
   std::uint64_t fixes = 0;             // NAV-PVT epochs given to the buffer
   std::uint64_t high_precision = 0;    // … of which placed with NAV-HPPOSLLH
-  std::uint64_t invalid_position = 0;  // epochs flagged invalidLlh
+  std::uint64_t invalid_position = 0;  // epochs flagged invalidLlh, or off the WGS-84 range / the frame
   std::uint64_t malformed = 0;         // framed UBX/VN-100 that did not decode
   std::uint64_t attitudes = 0;
   std::uint64_t imu_without_attitude = 0;  // frames lacking TimeStartup or YawPitchRoll
@@ -86,6 +86,7 @@ class PoseInput {
   ClockMap imu_clock_;
   std::optional<ublox::NavHpposllh> hp_;
   std::optional<pose::Geodetic> last_position_;
+  std::optional<Eigen::Vector3d> last_global_;  // last_position_ in the global frame
   PoseInputCounters counters_;
 };
 
