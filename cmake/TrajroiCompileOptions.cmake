@@ -9,8 +9,13 @@ function(trajroi_target_defaults target)
   set_target_properties(${target} PROPERTIES CXX_EXTENSIONS OFF)
   target_compile_options(${target} PRIVATE
     -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wsign-conversion
-    -Wnon-virtual-dtor -Wold-style-cast -Wnull-dereference -Wdouble-promotion
+    -Wnon-virtual-dtor -Wold-style-cast -Wdouble-promotion
     -ffp-contract=off)
+  # GCC 12 under -fsanitize=thread reports null dereferences inside libstdc++'s own string
+  # moves (false positives); the check stays on in every other build.
+  if(NOT CMAKE_CXX_FLAGS MATCHES "sanitize=thread")
+    target_compile_options(${target} PRIVATE -Wnull-dereference)
+  endif()
   if(TRAJROI_WERROR)
     target_compile_options(${target} PRIVATE -Werror)
   endif()

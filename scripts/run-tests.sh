@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
 # The README's test command: installs every dependency, builds with warnings as errors, and
-# runs the whole test suite twice through ctest — a release build, then an AddressSanitizer +
-# UndefinedBehaviorSanitizer build (the parsers, the vector scans and the daemon run under
-# both) — and the lock-free ring's tests under ThreadSanitizer.
-#   TRAJROI_SKIP_SANITIZERS=1  skips the sanitizer pass (quicker local runs).
+# runs, each through ctest:
+#   1. the whole suite, release build;
+#   2. the whole suite under AddressSanitizer + UndefinedBehaviorSanitizer (preset asan);
+#   3. the threaded tests — the lock-free ring, the daemon end to end and its control — under
+#      ThreadSanitizer (preset tsan);
+#   4. every fuzz target for TRAJROI_FUZZ_SECONDS (default 60) with ASan + UBSan (preset
+#      fuzz, scripts/fuzz.sh), which fails on any crash, leak or timeout.
+#   TRAJROI_SKIP_SANITIZERS=1  runs the release suite only (quicker local runs).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
@@ -19,6 +23,7 @@ if [ "${TRAJROI_SKIP_SANITIZERS:-0}" != "1" ]; then
   cmake --build --preset asan -j"$jobs"
   ctest --preset asan -j"$jobs"
   cmake --preset tsan
-  cmake --build --preset tsan -j"$jobs" --target transport_tests
-  ctest --preset tsan -j"$jobs" -R '^SpscRing\.'
+  cmake --build --preset tsan -j"$jobs" --target transport_tests daemon_tests
+  ctest --preset tsan -j"$jobs" -R '^(SpscRing|TrajroidEndToEnd|TrajroidControl)\.'
+  bash scripts/fuzz.sh "${TRAJROI_FUZZ_SECONDS:-60}"
 fi
