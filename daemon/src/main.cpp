@@ -24,6 +24,10 @@ int main(int argc, char** argv) {
   app.add_option("--record", record, "Record every raw input with its host receive time into this folder");
   app.add_option("--lcm-url", lcm_url, "LCM provider URL (overrides lcm.url)");
   app.add_flag("--check-config", check_config, "Check the configuration, print a summary and exit");
+  double stall_after_s = -1.0;
+  app.add_option("--inject-processing-stall", stall_after_s,
+                 "Testing only: the processing thread stops making progress after SECONDS (watchdog test)")
+      ->group("Testing");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -41,6 +45,7 @@ int main(int argc, char** argv) {
   if (!replay.empty()) options.replay = replay;
   if (!record.empty()) options.record = record;
   options.lcm_url = lcm_url;
+  if (stall_after_s >= 0.0) options.stall_processing_after_s = stall_after_s;
   if (rate == "max") {
     options.rate = 0.0;
   } else if (rate == "realtime") {

@@ -16,6 +16,7 @@
 #include <cstring>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -579,7 +580,15 @@ void Daemon::processing() {
   const bool exact = options_.replay.has_value() && options_.rate == 0.0;
   RingSink sink(sweeps_, publish_wake_, exact, stop_);
   std::int64_t next_status = steady_ns() + kSecond_ns;
+  const std::int64_t stall_at = options_.stall_processing_after_s
+                                    ? steady_ns() + static_cast<std::int64_t>(*options_.stall_processing_after_s * 1e9)
+                                    : std::numeric_limits<std::int64_t>::max();
   for (;;) {
+    if (steady_ns() >= stall_at) {
+      log::warn("fault injection: the processing thread stops making progress");
+      while (!stop_.load(std::memory_order_relaxed)) std::this_thread::sleep_for(milliseconds(50));
+      break;
+    }
     processing_beat_.fetch_add(1, std::memory_order_relaxed);
     while (TrajectoryItem* t = trajectories_in_.front()) {
       processor_->offer_trajectory(std::move(t->trajectory));

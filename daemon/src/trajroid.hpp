@@ -15,6 +15,9 @@ struct RunOptions {
   double rate = 0.0;                            // replay pace: 0 as fast as possible, 1 real time, N × real time
   std::optional<std::filesystem::path> record;  // write every raw input here (same layout)
   std::string lcm_url;                          // overrides lcm.url when set
+  // Fault injection for the watchdog test: after this many seconds the processing thread
+  // stops making progress (it only sleeps, until the process is stopped or killed).
+  std::optional<double> stall_processing_after_s;
 };
 
 inline constexpr const char* kLidarFile = "lidar.pcap";

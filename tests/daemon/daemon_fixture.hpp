@@ -11,6 +11,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
@@ -65,10 +66,13 @@ inline const fs::path& corridor_run() {
 // A running trajroid.
 class Child {
  public:
-  Child(const std::vector<std::string>& args, const fs::path& stderr_file) {
+  // `environment`: NAME=value entries added to the child's environment.
+  Child(const std::vector<std::string>& args, const fs::path& stderr_file,
+        const std::vector<std::string>& environment = {}) {
     pid_ = fork();
     if (pid_ == 0) {
       std::freopen(stderr_file.c_str(), "w", stderr);
+      for (const std::string& e : environment) putenv(strdup(e.c_str()));
       std::vector<char*> argv;
       static std::string program = TRAJROID;
       argv.push_back(program.data());
@@ -86,6 +90,7 @@ class Child {
     }
   }
   void signal(int sig) const { kill(pid_, sig); }
+  [[nodiscard]] pid_t pid() const noexcept { return pid_; }
   // The exit code, or -1 when it did not exit within the timeout (then it is killed).
   int wait(std::chrono::milliseconds timeout) {
     const auto until = std::chrono::steady_clock::now() + timeout;

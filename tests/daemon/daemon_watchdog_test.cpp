@@ -1,0 +1,141 @@
+// systemd's side of Type=notify and WatchdogSec, played by the test: trajroid is started with
+// NOTIFY_SOCKET pointing at a datagram socket here and WATCHDOG_USEC=1 s, as systemd starts
+// it. The test does what the service manager does: waits for READY=1, expects WATCHDOG=1
+// within every watchdog interval, and when one is missed sends WatchdogSignal (SIGABRT), which
+// ends the process abnormally so that Restart=on-failure starts it again; the new instance must
+// come up and feed the watchdog.
+#include <gtest/gtest.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "daemon_fixture.hpp"
+
+namespace {
+
+using namespace daemon_test;
+using Clock = std::chrono::steady_clock;
+using std::chrono::milliseconds;
+using std::chrono::seconds;
+
+constexpr auto kWatchdog = milliseconds(1000);
+
+class NotifySocket {
+ public:
+  NotifySocket() : path_(fs::temp_directory_path() / ("trajroid_notify_" + std::to_string(::getpid()) + ".sock")) {
+    fs::remove(path_);
+    fd_ = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    sockaddr_un a{};
+    a.sun_family = AF_UNIX;
+    std::snprintf(a.sun_path, sizeof a.sun_path, "%s", path_.c_str());
+    bound_ = fd_ >= 0 && bind(fd_, reinterpret_cast<const sockaddr*>(&a), sizeof a) == 0;
+    timeval tv{0, 20'000};
+    (void)setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  }
+  ~NotifySocket() {
+    if (fd_ >= 0) close(fd_);
+    fs::remove(path_);
+  }
+  [[nodiscard]] bool bound() const { return bound_; }
+  [[nodiscard]] std::string environment() const { return "NOTIFY_SOCKET=" + path_.string(); }
+  // One notification, or nothing within 20 ms.
+  std::optional<std::string> receive() {
+    char buffer[4096];
+    const ssize_t n = recv(fd_, buffer, sizeof buffer, 0);
+    if (n <= 0) return std::nullopt;
+    return std::string(buffer, static_cast<std::size_t>(n));
+  }
+
+ private:
+  fs::path path_;
+  int fd_ = -1;
+  bool bound_ = false;
+};
+
+bool has_line(const std::string& message, const std::string& line) {
+  std::istringstream in(message);
+  for (std::string l; std::getline(in, l);) {
+    if (l == line) return true;
+  }
+  return false;
+}
+
+struct Supervision {
+  std::optional<Clock::duration> ready_after;
+  std::vector<Clock::duration> watchdog_at;  // since start
+  std::optional<Clock::duration> timed_out_at;
+};
+
+// Supervises like systemd for at most `limit`: READY first, then WATCHDOG=1 at least once per
+// kWatchdog; on a miss, SIGABRT.
+Supervision supervise(NotifySocket& notify, Child& child, Clock::duration limit) {
+  Supervision s;
+  const auto start = Clock::now();
+  auto last_feed = start;
+  while (Clock::now() - start < limit) {
+    if (const auto m = notify.receive()) {
+      const auto t = Clock::now() - start;
+      if (has_line(*m, "READY=1") && !s.ready_after) {
+        s.ready_after = t;
+        last_feed = Clock::now();
+      }
+      if (has_line(*m, "WATCHDOG=1")) {
+        s.watchdog_at.push_back(t);
+        last_feed = Clock::now();
+      }
+    }
+    if (s.ready_after && Clock::now() - last_feed > kWatchdog) {
+      s.timed_out_at = Clock::now() - start;
+      child.signal(SIGABRT);
+      break;
+    }
+  }
+  return s;
+}
+
+double seconds_of(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+TEST(TrajroidWatchdog, AStuckProcessingThreadStopsTheWatchdogAndTheServiceIsRestarted) {
+  NotifySocket notify;
+  ASSERT_TRUE(notify.bound());
+  const fs::path dir = corridor_run();
+  const std::vector<std::string> args{"--config", (dir / "trajroid.yaml").string(), "--replay", dir.string(),
+                                      "--rate", "1", "--lcm-url", kTestLcmUrl};
+  const std::vector<std::string> env{notify.environment(), "WATCHDOG_USEC=" + std::to_string(kWatchdog.count() * 1000)};
+  const fs::path log = fs::temp_directory_path() / ("trajroid_watchdog_" + std::to_string(::getpid()) + ".log");
+
+  // 1. Stuck after 3 s: fed until then, then silent; the manager's SIGABRT ends it abnormally.
+  {
+    std::vector<std::string> stalled = args;
+    stalled.insert(stalled.end(), {"--inject-processing-stall", "3"});
+    Child child(stalled, log, env);
+    const Supervision s = supervise(notify, child, seconds(15));
+    ASSERT_TRUE(s.ready_after.has_value()) << slurp(log);
+    EXPECT_LT(seconds_of(*s.ready_after), 2.0);
+    const auto fed_before_stall = std::count_if(s.watchdog_at.begin(), s.watchdog_at.end(),
+                                                [&](Clock::duration t) { return seconds_of(t) < 3.0; });
+    EXPECT_GE(fed_before_stall, 8) << "fed about every quarter of the interval while healthy";
+    ASSERT_TRUE(s.timed_out_at.has_value()) << "the watchdog kept being fed by a stuck daemon";
+    EXPECT_GT(seconds_of(*s.timed_out_at), 3.0);
+    EXPECT_LT(seconds_of(*s.timed_out_at), 3.0 + seconds_of(kWatchdog) + 1.0);
+    const int code = child.wait(seconds(5));
+    EXPECT_EQ(code, 128 + SIGABRT) << "ended abnormally: Restart=on-failure restarts it\n" << slurp(log);
+    EXPECT_NE(slurp(log).find("fault injection"), std::string::npos);
+  }
+  // 2. The restarted instance: ready, fed, and stops cleanly.
+  {
+    Child child(args, log, env);
+    const Supervision s = supervise(notify, child, seconds(3));
+    ASSERT_TRUE(s.ready_after.has_value()) << slurp(log);
+    EXPECT_FALSE(s.timed_out_at.has_value());
+    EXPECT_GE(s.watchdog_at.size(), 8u);
+    child.signal(SIGTERM);
+    EXPECT_EQ(child.wait(seconds(2)), 0) << slurp(log);
+  }
+  fs::remove(log);
+}
+
+}  // namespace
