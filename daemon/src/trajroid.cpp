@@ -640,8 +640,10 @@ void Daemon::processing() {
       next_status += kSecond_ns;
       if (next_status < now) next_status = now + kSecond_ns;
     }
-    if (stop_.load(std::memory_order_relaxed)) break;
-    if (handled == 0 && inputs_done() && lidar_.size() == 0 && gnss_.size() == 0 && imu_.size() == 0) {
+    // Stopping (SIGTERM) or at the end of a replay: what was received is processed, and the
+    // sweep in progress goes out (partial) — nothing already received is lost.
+    const bool stopping = stop_.load(std::memory_order_relaxed);
+    if (handled == 0 && (stopping || (inputs_done() && lidar_.size() == 0 && gnss_.size() == 0 && imu_.size() == 0))) {
       processor_->flush(sink);
       break;
     }
