@@ -192,8 +192,8 @@ class Daemon {
            imu_done_.load(std::memory_order_acquire);
   }
 
-  template <typename T, typename Fill>
   // `notify`: wake the processing thread now; a paced replay wakes it once per batch.
+  template <typename T, typename Fill>
   bool push(Ring<T>& ring, bool wait_for_room, Fill fill, bool notify = true) {
     T* slot = ring.try_claim();
     while (slot == nullptr) {
