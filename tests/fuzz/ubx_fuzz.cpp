@@ -3,7 +3,7 @@
 #include <cstdint>
 
 #include "fuzz_input.hpp"
-#include "trajroi/pose_input/pose_input.hpp"
+#include "pose_input_harness.hpp"
 #include "trajroi/ublox/framer.hpp"
 #include "trajroi/ublox/messages.hpp"
 
@@ -20,17 +20,13 @@ void decode_all(const trajroi::ublox::Message& m) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const trajroi::pose::GlobalFrame frame =
-      trajroi::pose::GlobalFrame::local_cartesian(trajroi::pose::Geodetic{48.1351, 11.5820, 520.0});
   trajroi::ublox::Framer framer;
-  trajroi::pose::PoseBuffer buffer(trajroi::pose::PoseGate{}, Eigen::Vector3d::Zero(), 16);
-  trajroi::pose_input::PoseInput input(frame, trajroi::pose_input::PoseInputConfig{}, buffer);
-  std::int64_t t_ns = 1'000'000'000;
+  trajroi::fuzz::PoseInputHarness pose;
   trajroi::fuzz::for_each_piece(data, size, [&](std::span<const std::uint8_t> piece) {
     framer.feed(piece, decode_all);
-    input.gnss_bytes(piece, t_ns += 10'000'000);
+    pose.input.gnss_bytes(piece, pose.next_time());
   });
   framer.finish(decode_all);
-  (void)buffer.pose_at(t_ns);
+  (void)pose.buffer.pose_at(pose.t_ns);
   return 0;
 }
