@@ -65,21 +65,23 @@ Eigen::Isometry3d sensor_pose(const trajroi::points_t& m) {
                          m.sensor_orientation[3]));
 }
 
-std::string pose_argument(const Eigen::Isometry3d& g) {
-  const Eigen::Vector3d t = g.translation();
-  const Eigen::Quaterniond q(g.rotation());
+// trajroi filter's --pose argument: x,y,z,qw,qx,qy,qz printed to round-trip exactly.
+std::string pose_argument(const Eigen::Vector3d& t, double qw, double qx, double qy, double qz) {
   char text[512];
-  std::snprintf(text, sizeof text, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", t.x(), t.y(), t.z(), q.w(), q.x(),
-                q.y(), q.z());
+  std::snprintf(text, sizeof text, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", t.x(), t.y(), t.z(), qw, qx, qy, qz);
   return text;
 }
 
+std::string pose_argument(const Eigen::Isometry3d& g) {
+  const Eigen::Quaterniond q(g.rotation());
+  return pose_argument(g.translation(), q.w(), q.x(), q.y(), q.z());
+}
+
+// The published numbers themselves (no rotation-matrix round trip), for bit-exact comparison.
 std::string pose_argument(const trajroi::points_t& m) {
-  char text[512];
-  std::snprintf(text, sizeof text, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", m.sensor_position_m[0],
-                m.sensor_position_m[1], m.sensor_position_m[2], m.sensor_orientation[0], m.sensor_orientation[1],
-                m.sensor_orientation[2], m.sensor_orientation[3]);
-  return text;
+  return pose_argument(Eigen::Vector3d(m.sensor_position_m[0], m.sensor_position_m[1], m.sensor_position_m[2]),
+                       m.sensor_orientation[0], m.sensor_orientation[1], m.sensor_orientation[2],
+                       m.sensor_orientation[3]);
 }
 
 // Indices `trajroi filter` keeps of `frame` placed with the sweep's published sensor pose, or
@@ -153,14 +155,14 @@ struct Replay {
   std::string log;
 };
 
-Replay replay(const fs::path& config, Listener& listener, const char* rate) {
+// The listener must be subscribed before the replay starts; it keeps what it hears.
+Replay replay(const fs::path& config, const char* rate) {
   const fs::path err = config.parent_path() / (config.stem().string() + ".log");
   Child child({"--config", config.string(), "--replay", corridor_run().string(), "--rate", rate, "--lcm-url", kTestLcmUrl},
               err);
   Replay r;
   r.exit_code = child.wait(seconds(180));
   std::this_thread::sleep_for(milliseconds(300));  // the last datagrams on their way
-  (void)listener;
   r.log = slurp(err);
   return r;
 }
@@ -170,7 +172,7 @@ TEST(TrajroidEndToEnd, EverySweepArrivesAndMatchesTrajroiFilterExactlyWithOnePos
   const fs::path config = write_config(prefix, "per_sweep");
   Listener listener(prefix);
   ASSERT_TRUE(listener.good());
-  const Replay r = replay(config, listener, replay_rate());
+  const Replay r = replay(config, replay_rate());
   ASSERT_EQ(r.exit_code, 0) << r.log;
 
   const auto frames = decode_capture(corridor_run() / "lidar.pcap");
@@ -247,7 +249,7 @@ TEST(TrajroidEndToEnd, PerFiringMotionCompensationDiffersFromTheMidSweepPoseOnly
   const fs::path config = write_config(prefix, "per_firing");
   Listener listener(prefix);
   ASSERT_TRUE(listener.good());
-  const Replay r = replay(config, listener, replay_rate());
+  const Replay r = replay(config, replay_rate());
   ASSERT_EQ(r.exit_code, 0) << r.log;
   const auto frames = decode_capture(corridor_run() / "lidar.pcap");
   std::lock_guard<std::mutex> lock(listener.mutex);
@@ -288,7 +290,7 @@ TEST(TrajroidEndToEnd, TheSameReplayGivesTheSameOutput) {
     const std::string prefix = unique_prefix(run == 0 ? "SAME_A" : "SAME_B");
     const fs::path config = write_config(prefix, "per_firing");
     Listener listener(prefix);
-    const Replay r = replay(config, listener, replay_rate());
+    const Replay r = replay(config, replay_rate());
     ASSERT_EQ(r.exit_code, 0) << r.log;
     std::lock_guard<std::mutex> lock(listener.mutex);
     ASSERT_FALSE(listener.statuses.empty());

@@ -72,7 +72,7 @@ struct Collect final : trajroi::daemon::SweepSink {
 // Feeds the run; `before_lidar(processor, sink)` runs before each lidar datagram. `with_gnss`
 // false leaves the GNSS stream out.
 template <typename Hook>
-Collect drive(const DaemonConfig& config, SweepProcessor& processor, bool with_gnss, Hook before_lidar) {
+Collect drive(SweepProcessor& processor, bool with_gnss, Hook before_lidar) {
   Collect sink;
   for (const Event& e : run_events()) {
     if (e.kind == Event::kGnss) {
@@ -85,12 +85,11 @@ Collect drive(const DaemonConfig& config, SweepProcessor& processor, bool with_g
     }
   }
   processor.flush(sink);
-  (void)config;
   return sink;
 }
 
-Collect drive(const DaemonConfig& config, SweepProcessor& processor, bool with_gnss = true) {
-  return drive(config, processor, with_gnss, [](SweepProcessor&, Collect&) {});
+Collect drive(SweepProcessor& processor, bool with_gnss = true) {
+  return drive(processor, with_gnss, [](SweepProcessor&, Collect&) {});
 }
 
 TEST(SweepProcessor, TheRoiGrowsWithSpeedAndTheGrowthIsCapped) {
@@ -99,12 +98,12 @@ TEST(SweepProcessor, TheRoiGrowsWithSpeedAndTheGrowthIsCapped) {
   config.roi.width_per_mps_s = 2.0;
   config.roi.max_speed_mps = 5.0;
   SweepProcessor grown(config, trajectory_from(config.trajectory_file, 0));
-  const Collect free_run = drive(config, grown);
+  const Collect free_run = drive(grown);
 
   DaemonConfig capped_config = config;
   capped_config.roi.max_speed_mps = 0.5;
   SweepProcessor capped(capped_config, trajectory_from(config.trajectory_file, 0));
-  const Collect capped_run = drive(capped_config, capped);
+  const Collect capped_run = drive(capped);
   ASSERT_EQ(free_run.sweeps.size(), capped_run.sweeps.size());
 
   const auto& r = config.roi;
@@ -153,7 +152,7 @@ TEST(SweepProcessor, ATrajectoryOfferedInsideASweepTakesEffectAtTheNextOne) {
   std::size_t datagrams_in_sweep = 0;
   std::uint64_t last_index = 0;
   bool offered = false;
-  const Collect run = drive(config, processor, true, [&](SweepProcessor& p, Collect& sink) {
+  const Collect run = drive(processor, true, [&](SweepProcessor& p, Collect& sink) {
     if (p.current().index != last_index) {
       last_index = p.current().index;
       datagrams_in_sweep = 0;
@@ -185,7 +184,7 @@ TEST(SweepProcessor, ATrajectoryOfferedInsideASweepTakesEffectAtTheNextOne) {
 TEST(SweepProcessor, WithoutGnssNoSweepIsFilteredAndEachSaysWhy) {
   const DaemonConfig config = run_config();
   SweepProcessor processor(config, trajectory_from(config.trajectory_file, 0));
-  const Collect run = drive(config, processor, false);
+  const Collect run = drive(processor, false);
   ASSERT_GT(run.sweeps.size(), 200u);
   for (const Sweep& s : run.sweeps) {
     EXPECT_FALSE(s.filtered);
