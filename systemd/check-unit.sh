@@ -1,9 +1,23 @@
 #!/usr/bin/env bash
 # Checks a trajroid unit: `systemd-analyze verify` is clean and the offline security exposure
-# is at most the given score. Usage: check-unit.sh UNIT MAX_EXPOSURE
+# is at most the given score. With DROP_IN files, checks the unit as systemd would load it
+# with them (their [Service] settings after the unit's own).
+# Usage: check-unit.sh UNIT MAX_EXPOSURE [DROP_IN...]
 set -euo pipefail
 unit=$1
 max=$2
+shift 2
+if [ $# -gt 0 ]; then
+  merged_dir=$(mktemp -d)
+  trap 'rm -rf "$merged_dir"' EXIT
+  merged="$merged_dir/$(basename "$unit")"
+  {
+    sed '/^\[Install\]/,$d' "$unit"
+    for drop_in in "$@"; do sed '1,/^\[Service\]/d' "$drop_in"; done
+    sed -n '/^\[Install\]/,$p' "$unit"
+  } >"$merged"
+  unit=$merged
+fi
 if ! command -v systemd-analyze >/dev/null; then
   echo "check-unit: systemd-analyze not installed (scripts/install-deps.sh installs it)" >&2
   exit 1

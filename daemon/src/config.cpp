@@ -1,5 +1,7 @@
 #include "trajroi/daemon/config.hpp"
 
+#include <arpa/inet.h>
+
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -33,6 +35,15 @@ std::uint16_t port(MapReader& m, std::string_view key, std::uint16_t fallback) {
   const std::int64_t v = m.integer(key, fallback);
   m.require(v >= 0 && v <= 65535, key, "must be a UDP port 0 … 65535");
   return static_cast<std::uint16_t>(v);
+}
+
+// A dotted IPv4 address; `allow_empty` for an optional one.
+std::string ipv4(MapReader& m, std::string_view key, const char* fallback, bool allow_empty) {
+  std::string text = m.text(key, fallback);
+  in_addr parsed{};
+  m.require((allow_empty && text.empty()) || inet_pton(AF_INET, text.c_str(), &parsed) == 1, key,
+            "must be a dotted IPv4 address");
+  return text;
 }
 
 Eigen::Isometry3d read_mounting(MapReader m) {
@@ -109,7 +120,9 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
     c.lidar.cut_azimuth_deg = l.number("cut_azimuth_deg", 0.0);
     l.require(c.lidar.cut_azimuth_deg >= 0.0 && c.lidar.cut_azimuth_deg < 360.0, "cut_azimuth_deg",
               "must be in [0, 360)");
-    c.lidar.bind_address = l.text("bind_address", "0.0.0.0");
+    c.lidar.bind_address = ipv4(l, "bind_address", "0.0.0.0", false);
+    c.lidar.sensor_address = ipv4(l, "sensor_address", "", true);
+    l.require(c.lidar.sensor_address != "0.0.0.0", "sensor_address", "must name one host (empty accepts any)");
     c.lidar.data_port = port(l, "data_port", 2368);
     c.lidar.position_port = port(l, "position_port", 8308);
     c.lidar.receive_buffer_bytes =

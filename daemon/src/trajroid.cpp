@@ -243,6 +243,8 @@ class Daemon {
   // CPU time of each kind of thread, added as each ends (for the summary).
   std::atomic<std::int64_t> cpu_sources_ns_{0}, cpu_processing_ns_{0}, cpu_publishing_ns_{0};
   std::atomic<std::uint64_t> oversize_datagrams_{0}, source_errors_{0}, serial_disconnects_{0};
+  // Copied from the UDP source by its thread.
+  std::atomic<std::uint64_t> rejected_sources_{0}, kernel_drops_{0};
 
   // Publisher-owned.
   std::array<std::uint64_t, kTrajectoryRejectCount> trajectory_rejects_{};
@@ -287,10 +289,11 @@ void Daemon::open_sources() {
   udp.data_port = config_.lidar.data_port;
   udp.position_port = config_.lidar.position_port;
   udp.receive_buffer_bytes = config_.lidar.receive_buffer_bytes;
+  udp.sensor_address = config_.lidar.sensor_address;
   udp_ = std::make_unique<vlp16::UdpSource>(udp);
   if (const std::string w = udp_->receive_buffer_warning(); !w.empty()) log::warn("{}", w);
-  log::info("lidar: UDP {}:{} (data), :{} (position)", config_.lidar.bind_address, udp_->data_port(),
-            udp_->position_port());
+  log::info("lidar: UDP {}:{} (data), :{} (position), from {}", config_.lidar.bind_address, udp_->data_port(),
+            udp_->position_port(), udp.sensor_address.empty() ? "any sender" : udp.sensor_address + " only");
   const auto open_port = [](const DaemonConfig::Serial& s, const char* what, std::atomic<bool>& done) {
     if (s.device.empty()) {
       log::warn("{}: no device configured: that stream is silent", what);
@@ -300,6 +303,8 @@ void Daemon::open_sources() {
     serial::SerialPortOptions o;
     o.device = s.device;
     o.baud = s.baud;
+    // A receiver that comes back (cable, USB re-enumeration) is read again within 0.5 s.
+    o.max_backoff = milliseconds(500);
     log::info("{}: {} at {} baud", what, s.device, s.baud);
     return std::make_unique<serial::SerialPortSource>(o);
   };
@@ -315,6 +320,8 @@ void Daemon::lidar_live() {
   vlp16::Datagram d;
   while (!stop_.load(std::memory_order_relaxed)) {
     const auto next = udp_->next(d, milliseconds(kIdleWait_ms));
+    rejected_sources_.store(udp_->rejected_sources(), std::memory_order_relaxed);
+    kernel_drops_.store(udp_->kernel_drops(), std::memory_order_relaxed);
     if (next == vlp16::PacketSource::Next::kTimeout) continue;
     if (next != vlp16::PacketSource::Next::kDatagram) {
       source_errors_.fetch_add(1, std::memory_order_relaxed);
@@ -359,13 +366,20 @@ void Daemon::serial_live(serial::SerialPortSource& source, Ring<SerialItem>& rin
   if (const std::string w = apply_thread_config(name, thread); !w.empty()) log::warn("{}", w);
   prefault_stack();
   serial::Chunk chunk;
+  std::uint64_t opens = 0;
   while (!stop_.load(std::memory_order_relaxed)) {
     const serial::ReadStatus status = source.read(chunk, milliseconds(kIdleWait_ms));
+    if (source.counters().opens != opens) {
+      opens = source.counters().opens;
+      log::info("{}: {} open ({} backend)", name, source.describe(),
+                source.backend() == serial::SerialPortSource::Backend::kTermios ? "termios" : "libserialport");
+    }
     if (status == serial::ReadStatus::kData) {
       push_serial(ring, false, chunk.bytes, chunk.receive_time_ns);
     } else if (status == serial::ReadStatus::kDisconnected) {
       serial_disconnects_.fetch_add(1, std::memory_order_relaxed);
-      warn_rate_limited(source.describe() + ": disconnected (" + source.last_error() + "); reopening");
+      // Rare and important: every one is logged (a reopen follows within the backoff, ≤ 0.5 s).
+      log::warn("{}: {} disconnected ({}); reopening", name, source.describe(), source.last_error());
     }
   }
   cpu_sources_ns_.fetch_add(thread_cpu_ns());
@@ -512,6 +526,8 @@ void Daemon::snapshot(bool final) {
   }
   s->add("lidar.oversize_datagrams", oversize_datagrams_.load(std::memory_order_relaxed));
   s->add("lidar.source_errors", source_errors_.load(std::memory_order_relaxed));
+  s->add("lidar.rejected_source", rejected_sources_.load(std::memory_order_relaxed));
+  s->add("lidar.kernel_drops", kernel_drops_.load(std::memory_order_relaxed));
   for (std::size_t i = 1; i < vlp16::kPacketErrorCount; ++i) {
     s->add(vlp16::to_string(static_cast<vlp16::PacketError>(i)), l.rejected[i]);
   }

@@ -35,28 +35,6 @@ fs::path write_config(const std::string& prefix, const std::string& pose_mode, c
 std::string unique_prefix(const char* name) { return "TRJTEST_" + std::to_string(::getpid()) + "_" + name; }
 
 // The capture decoded here, as trajroid's configuration asks (min 0.5 m, max 60 m).
-std::vector<trajroi::vlp16::Frame> decode_capture(const fs::path& pcap) {
-  struct Collect final : trajroi::vlp16::FrameSink {
-    std::vector<trajroi::vlp16::Frame> frames;
-    void on_frame(const trajroi::vlp16::Frame& f) override { frames.push_back(f); }
-  } sink;
-  trajroi::vlp16::StreamOptions options;
-  options.decode.min_range_m = 0.5;
-  options.decode.max_range_m = 60.0;
-  trajroi::vlp16::StreamDecoder decoder(trajroi::vlp16::Calibration::vlp16_default(), options);
-  trajroi::vlp16::PcapSource source(pcap);
-  trajroi::vlp16::Datagram d;
-  while (source.next(d) == trajroi::vlp16::PacketSource::Next::kDatagram) {
-    if (d.destination_port == trajroi::vlp16::kDataPort) {
-      decoder.on_data_packet(d.payload, d.receive_time_ns, sink);
-    } else {
-      decoder.on_position_packet(d.payload);
-    }
-  }
-  decoder.flush(sink);
-  return std::move(sink.frames);
-}
-
 // The sensor pose a points_t publishes (the sweep's start).
 Eigen::Isometry3d sensor_pose(const trajroi::points_t& m) {
   return trajroi::roi::pose_from_position_quaternion(

@@ -28,6 +28,8 @@
 #include "trajroi/status_t.hpp"
 #include "trajroi/transport/lcm_subscribe.hpp"
 #include "trajroi/trajectory_t.hpp"
+#include "trajroi/vlp16/pcap_source.hpp"
+#include "trajroi/vlp16/stream_decoder.hpp"
 
 namespace daemon_test {
 
@@ -47,41 +49,63 @@ inline int run_command(const std::string& command) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-// The scenario run every test replays (tests/daemon/corridor.yaml), simulated on first use.
-inline const fs::path& corridor_run() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::temp_directory_path() / ("trajroid_test_run_" + std::to_string(::getpid()));
-    const std::string cmd = std::string(TRAJROI_CLI) + " sim --quiet --scenario " + TRAJROI_TEST_SCENARIO +
-                            " --out " + d.string() + " >/dev/null";
-    if (run_command(cmd) != 0) throw std::runtime_error("cannot simulate the test scenario: " + cmd);
+// Simulates `scenario` into a temporary run folder (removed at exit).
+inline fs::path simulate(const std::string& scenario, const std::string& tag) {
+  static std::vector<fs::path> made;
+  const fs::path d = fs::temp_directory_path() / ("trajroid_test_" + tag + "_" + std::to_string(::getpid()));
+  const std::string cmd = std::string(TRAJROI_CLI) + " sim --quiet --scenario " + scenario + " --out " + d.string() +
+                          " >/dev/null";
+  if (run_command(cmd) != 0) throw std::runtime_error("cannot simulate the test scenario: " + cmd);
+  if (made.empty()) {
     std::atexit([] {
       std::error_code ignored;
-      fs::remove_all(fs::temp_directory_path() / ("trajroid_test_run_" + std::to_string(::getpid())), ignored);
+      for (const fs::path& p : made) fs::remove_all(p, ignored);
     });
-    return d;
-  }();
+  }
+  made.push_back(d);
+  return d;
+}
+
+// The scenario run most tests replay (tests/daemon/corridor.yaml), simulated on first use.
+inline const fs::path& corridor_run() {
+  static const fs::path dir = simulate(TRAJROI_TEST_SCENARIO, "run");
   return dir;
 }
 
-// A running trajroid.
+// The capture decoded as the daemon decodes it (the test scenarios' ranges), sweep by sweep.
+inline std::vector<trajroi::vlp16::Frame> decode_capture(const fs::path& pcap) {
+  struct Collect final : trajroi::vlp16::FrameSink {
+    std::vector<trajroi::vlp16::Frame> frames;
+    void on_frame(const trajroi::vlp16::Frame& f) override { frames.push_back(f); }
+  } sink;
+  trajroi::vlp16::StreamOptions options;
+  options.decode.min_range_m = 0.5;
+  options.decode.max_range_m = 60.0;
+  trajroi::vlp16::StreamDecoder decoder(trajroi::vlp16::Calibration::vlp16_default(), options);
+  trajroi::vlp16::PcapSource source(pcap);
+  trajroi::vlp16::Datagram d;
+  while (source.next(d) == trajroi::vlp16::PacketSource::Next::kDatagram) {
+    if (d.destination_port == trajroi::vlp16::kDataPort) {
+      decoder.on_data_packet(d.payload, d.receive_time_ns, sink);
+    } else {
+      decoder.on_position_packet(d.payload);
+    }
+  }
+  decoder.flush(sink);
+  return std::move(sink.frames);
+}
+
+
+// A running trajroid (or, with `program`, another tool: its stdout goes to the file too).
 class Child {
  public:
   // `environment`: NAME=value entries added to the child's environment.
   Child(const std::vector<std::string>& args, const fs::path& stderr_file,
         const std::vector<std::string>& environment = {}) {
-    pid_ = fork();
-    if (pid_ == 0) {
-      std::freopen(stderr_file.c_str(), "w", stderr);
-      for (const std::string& e : environment) putenv(strdup(e.c_str()));
-      std::vector<char*> argv;
-      static std::string program = TRAJROID;
-      argv.push_back(program.data());
-      std::vector<std::string> copy = args;
-      for (std::string& a : copy) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      execv(TRAJROID, argv.data());
-      _exit(127);
-    }
+    start(TRAJROID, args, stderr_file, environment, false);
+  }
+  Child(const std::string& program, const std::vector<std::string>& args, const fs::path& output_file) {
+    start(program, args, output_file, {}, true);
   }
   ~Child() {
     if (pid_ > 0 && !exited_) {
@@ -90,24 +114,48 @@ class Child {
     }
   }
   void signal(int sig) const { kill(pid_, sig); }
+  [[nodiscard]] bool running() { return !reaped(); }
   [[nodiscard]] pid_t pid() const noexcept { return pid_; }
   // The exit code, or -1 when it did not exit within the timeout (then it is killed).
   int wait(std::chrono::milliseconds timeout) {
     const auto until = std::chrono::steady_clock::now() + timeout;
-    int status = 0;
     while (std::chrono::steady_clock::now() < until) {
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        exited_ = true;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
+      if (reaped()) return code_;
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
     return -1;
   }
 
  private:
+  bool reaped() {
+    int status = 0;
+    if (!exited_ && waitpid(pid_, &status, WNOHANG) == pid_) {
+      exited_ = true;
+      code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    }
+    return exited_;
+  }
+
+  void start(const std::string& program, const std::vector<std::string>& args, const fs::path& output_file,
+             const std::vector<std::string>& environment, bool stdout_too) {
+    pid_ = fork();
+    if (pid_ == 0) {
+      std::freopen(output_file.c_str(), "w", stderr);
+      if (stdout_too) dup2(fileno(stderr), STDOUT_FILENO);
+      for (const std::string& e : environment) putenv(strdup(e.c_str()));
+      std::vector<std::string> copy = args;
+      copy.insert(copy.begin(), program);
+      std::vector<char*> argv;
+      for (std::string& a : copy) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execv(program.c_str(), argv.data());
+      _exit(127);
+    }
+  }
+
   pid_t pid_ = -1;
   bool exited_ = false;
+  int code_ = -1;
 };
 
 // Everything trajroid publishes on a test's channels.

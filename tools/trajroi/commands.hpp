@@ -12,6 +12,7 @@ void add_serial_dump_commands(CLI::App& app);  // gnss-dump, imu-dump
 void add_sim_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_watch_command(CLI::App& app);  // listens to trajroid over LCM
+void add_feed_command(CLI::App& app);   // plays a run folder into a live trajroid
 // keyframes, sequential, accumulated under `eval`.
 void add_scenario_eval_commands(CLI::App& eval_cmd);
 

@@ -17,7 +17,8 @@ namespace {
 
 // Big enough for any Velodyne datagram (1206 or 512 bytes) and an Ethernet MTU.
 constexpr std::size_t kBufferBytes = 1536;
-constexpr std::size_t kControlBytes = CMSG_SPACE(sizeof(timespec));
+// A receive timestamp and the socket's drop counter (SO_RXQ_OVFL).
+constexpr std::size_t kControlBytes = CMSG_SPACE(sizeof(timespec)) + CMSG_SPACE(sizeof(std::uint32_t));
 
 std::int64_t realtime_now_ns() noexcept {
   timespec now{};
@@ -29,6 +30,13 @@ std::int64_t realtime_now_ns() noexcept {
 
 UdpSource::UdpSource(UdpOptions options) : options_(std::move(options)) {
   if (options_.batch == 0) options_.batch = 1;
+  if (!options_.sensor_address.empty()) {
+    in_addr sensor{};
+    if (inet_pton(AF_INET, options_.sensor_address.c_str(), &sensor) != 1 || sensor.s_addr == 0) {
+      throw std::runtime_error("UDP sensor address '" + options_.sensor_address + "' is not an IPv4 host address");
+    }
+    sensor_address_ = sensor.s_addr;
+  }
   open_socket(sockets_[0], options_.data_port, true);
   if (options_.open_position_socket) open_socket(sockets_[1], options_.position_port, false);
 }
@@ -55,6 +63,10 @@ void UdpSource::open_socket(Socket& socket, std::uint16_t port, bool data) {
   if (setsockopt(socket.fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on) != 0) {
     throw std::runtime_error("UDP " + where + ": SO_TIMESTAMPNS: " + std::strerror(errno));
   }
+  // The kernel's count of datagrams it dropped for a full receive buffer, with each datagram.
+  if (setsockopt(socket.fd, SOL_SOCKET, SO_RXQ_OVFL, &on, sizeof on) != 0) {
+    throw std::runtime_error("UDP " + where + ": SO_RXQ_OVFL: " + std::strerror(errno));
+  }
   if (data) {
     // SO_RCVBUFFORCE passes net.core.rmem_max when the process may (CAP_NET_ADMIN).
     const int& bytes = options_.receive_buffer_bytes;
@@ -80,6 +92,7 @@ void UdpSource::open_socket(Socket& socket, std::uint16_t port, bool data) {
   socket.control.assign(batch * kControlBytes, 0);
   socket.headers.assign(batch, mmsghdr{});
   socket.iovecs.assign(batch, iovec{});
+  socket.senders.assign(batch, sockaddr_in{});
 }
 
 std::string UdpSource::receive_buffer_warning() const {
@@ -97,6 +110,8 @@ bool UdpSource::receive_batch(Socket& socket) {
     header = msghdr{};
     header.msg_iov = &socket.iovecs[i];
     header.msg_iovlen = 1;
+    header.msg_name = &socket.senders[i];
+    header.msg_namelen = sizeof(sockaddr_in);
     header.msg_control = socket.control.data() + i * kControlBytes;
     header.msg_controllen = kControlBytes;
   }
@@ -114,6 +129,12 @@ bool UdpSource::receive_batch(Socket& socket) {
 }
 
 bool UdpSource::deliver(Socket& socket, Datagram& datagram) {
+  if (sensor_address_ != 0) {
+    while (socket.next < socket.count && socket.senders[socket.next].sin_addr.s_addr != sensor_address_) {
+      ++socket.next;
+      ++rejected_sources_;
+    }
+  }
   if (socket.next >= socket.count) return false;
   const std::size_t i = socket.next++;
   const mmsghdr& message = socket.headers[i];
@@ -128,6 +149,10 @@ bool UdpSource::deliver(Socket& socket, Datagram& datagram) {
       timespec stamp{};
       std::memcpy(&stamp, CMSG_DATA(c), sizeof stamp);
       datagram.receive_time_ns = static_cast<std::int64_t>(stamp.tv_sec) * 1'000'000'000 + stamp.tv_nsec;
+    } else if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {
+      std::uint32_t dropped = 0;
+      std::memcpy(&dropped, CMSG_DATA(c), sizeof dropped);
+      socket.kernel_drops = dropped;  // cumulative since the socket opened
     }
   }
   if (datagram.receive_time_ns == 0) datagram.receive_time_ns = realtime_now_ns();

@@ -45,6 +45,7 @@ struct DaemonConfig {
     double max_range_m = 130.0;
     double cut_azimuth_deg = 0.0;
     std::string bind_address = "0.0.0.0";
+    std::string sensor_address;  // only datagrams from this IPv4 address; empty: any (counted)
     std::uint16_t data_port = 2368;
     std::uint16_t position_port = 8308;
     int receive_buffer_bytes = 4 << 20;

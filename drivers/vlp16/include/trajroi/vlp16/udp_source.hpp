@@ -12,6 +12,7 @@
 
 struct mmsghdr;  // <sys/socket.h>, included by the implementation only
 struct iovec;
+struct sockaddr_in;
 
 namespace trajroi::vlp16 {
 
@@ -22,6 +23,9 @@ struct UdpOptions {
   bool open_position_socket = true;
   int receive_buffer_bytes = 4 << 20;  // SO_RCVBUF asked for; see granted_receive_buffer_bytes()
   std::size_t batch = 32;              // datagrams per recvmmsg
+  // When set (an IPv4 address), datagrams from any other source address are dropped and
+  // counted (rejected_sources()); empty accepts every sender.
+  std::string sensor_address;
 };
 
 class UdpSource final : public PacketSource {
@@ -47,6 +51,13 @@ class UdpSource final : public PacketSource {
   [[nodiscard]] std::uint16_t position_port() const noexcept { return sockets_[1].port; }
   // Datagrams truncated because they were longer than a Velodyne packet buffer.
   [[nodiscard]] std::uint64_t truncated() const noexcept { return truncated_; }
+  // Datagrams the kernel dropped because a socket's receive buffer was full (SO_RXQ_OVFL, as
+  // last reported with a received datagram), both sockets.
+  [[nodiscard]] std::uint64_t kernel_drops() const noexcept {
+    return std::uint64_t{sockets_[0].kernel_drops} + sockets_[1].kernel_drops;
+  }
+  // Datagrams dropped because they came from an address other than UdpOptions::sensor_address.
+  [[nodiscard]] std::uint64_t rejected_sources() const noexcept { return rejected_sources_; }
 
  private:
   struct Socket {
@@ -58,8 +69,10 @@ class UdpSource final : public PacketSource {
     std::vector<std::uint8_t> control;
     std::vector<mmsghdr> headers;
     std::vector<iovec> iovecs;
+    std::vector<sockaddr_in> senders;
     std::size_t count = 0;
     std::size_t next = 0;
+    std::uint32_t kernel_drops = 0;
   };
   void open_socket(Socket& socket, std::uint16_t port, bool data);
   bool deliver(Socket& socket, Datagram& datagram);
@@ -69,6 +82,8 @@ class UdpSource final : public PacketSource {
   Socket sockets_[2];
   int granted_ = 0;
   std::uint64_t truncated_ = 0;
+  std::uint64_t rejected_sources_ = 0;
+  std::uint32_t sensor_address_ = 0;  // network byte order; 0: any sender
   std::size_t turn_ = 0;  // alternate between sockets so neither starves
   std::string error_;
 };

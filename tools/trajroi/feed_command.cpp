@@ -1,0 +1,403 @@
+// trajroi feed: plays a run folder into a live trajroid as its sensors would — the VLP-16
+// datagrams over UDP to 127.0.0.1, the GNSS and IMU recordings through pseudo-terminals named
+// by udev-like symlinks — paced by their recorded receive times. For fault tests it can
+// unplug a serial device mid-frame and plug it back, flood the UDP port with copies and
+// malformed packets, and send from an address that is not the sensor's. It sends to the
+// loopback interface only.
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <stdlib.h>
+#include <sys/socket.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "trajroi/serial/byte_log.hpp"
+#include "trajroi/sim/run_folder.hpp"
+#include "trajroi/vlp16/pcap_source.hpp"
+
+namespace trajroi::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::int64_t monotonic_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return static_cast<std::int64_t>(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+}
+
+void sleep_until(std::int64_t deadline_ns) {
+  const timespec t{static_cast<time_t>(deadline_ns / 1'000'000'000), static_cast<long>(deadline_ns % 1'000'000'000)};
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &t, nullptr) == EINTR) {
+  }
+}
+
+// "gnss@6+2": the stream's device vanishes 6 s into the data and comes back 2 s later.
+struct Hangup {
+  std::string stream;
+  double at_s = 0.0;
+  double for_s = 0.0;
+};
+
+Hangup parse_hangup(const std::string& text) {
+  Hangup h;
+  const auto at = text.find('@');
+  const auto plus = text.find('+', at == std::string::npos ? 0 : at);
+  if (at == std::string::npos || plus == std::string::npos) {
+    throw std::invalid_argument("--hangup '" + text + "': expected STREAM@AT_S+FOR_S, e.g. gnss@6+2");
+  }
+  h.stream = text.substr(0, at);
+  try {
+    h.at_s = std::stod(text.substr(at + 1, plus - at - 1));
+    h.for_s = std::stod(text.substr(plus + 1));
+  } catch (const std::exception&) {
+    throw std::invalid_argument("--hangup '" + text + "': AT_S and FOR_S must be numbers");
+  }
+  if (h.stream != "gnss" && h.stream != "imu") throw std::invalid_argument("--hangup '" + text + "': stream is gnss or imu");
+  if (!(h.at_s >= 0.0) || !(h.for_s > 0.0)) throw std::invalid_argument("--hangup '" + text + "': AT_S >= 0, FOR_S > 0");
+  return h;
+}
+
+struct FeedOptions {
+  std::string run_dir;
+  double rate = 1.0;
+  std::uint16_t data_port = vlp16::kDataPort;
+  std::uint16_t position_port = vlp16::kPositionPort;
+  std::string from = "127.0.0.1";  // the sensor's (loopback) address
+  std::string gnss_link, imu_link;
+  double wait_for_readers_s = 30.0;
+  double linger_s = 0.0;  // after the data, the devices stay this long (the reader sees no unplug)
+  std::vector<std::string> hangups;
+  double flood_at_s = -1.0;  // < 0: no flood
+  double flood_for_s = 10.0;
+  double flood_factor = 20.0;
+  double malformed_fraction = 0.5;
+  std::string foreign_from;  // a second sender, not the sensor
+  unsigned foreign_every = 10;
+};
+
+// A pseudo-terminal standing in for a serial device: the feeder holds the master; the reader
+// opens the slave through a symlink. While no reader has the slave open the master polls
+// POLLHUP, which tells when the reader (re)opened it.
+class PtyDevice {
+ public:
+  PtyDevice(std::string name, fs::path link) : name_(std::move(name)), link_(std::move(link)) { appear(); }
+  ~PtyDevice() { vanish(); }
+  PtyDevice(const PtyDevice&) = delete;
+  PtyDevice& operator=(const PtyDevice&) = delete;
+
+  [[nodiscard]] bool present() const noexcept { return master_ >= 0; }
+  [[nodiscard]] bool reader_open() const {
+    if (master_ < 0) return false;
+    pollfd p{master_, 0, 0};
+    return ::poll(&p, 1, 0) >= 0 && (p.revents & POLLHUP) == 0;
+  }
+  // Writes what the reader can take now; false when there is no reader (nothing written).
+  bool write(std::span<const std::uint8_t> bytes) {
+    if (!reader_open()) return false;
+    std::size_t done = 0;
+    while (done < bytes.size()) {
+      const ssize_t n = ::write(master_, bytes.data() + done, bytes.size() - done);
+      if (n > 0) {
+        done += static_cast<std::size_t>(n);
+      } else if (n < 0 && errno == EAGAIN) {
+        pollfd p{master_, POLLOUT, 0};
+        if (::poll(&p, 1, 100) <= 0) break;  // a reader that stopped reading: drop the rest
+      } else if (n < 0 && errno == EINTR) {
+        continue;
+      } else {
+        break;
+      }
+    }
+    return true;
+  }
+  void appear() {
+    master_ = posix_openpt(O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+    if (master_ < 0 || grantpt(master_) != 0 || unlockpt(master_) != 0) {
+      throw std::runtime_error(name_ + ": cannot open a pseudo-terminal: " + std::strerror(errno));
+    }
+    const char* slave = ptsname(master_);
+    if (slave == nullptr) throw std::runtime_error(name_ + ": ptsname: " + std::strerror(errno));
+    // The master reports POLLHUP only once a slave has been opened and closed again: do that
+    // here, so that POLLHUP means "no reader yet".
+    const int probe = ::open(slave, O_RDWR | O_NOCTTY | O_CLOEXEC);
+    if (probe < 0) throw std::runtime_error(name_ + ": cannot open " + slave + ": " + std::strerror(errno));
+    ::close(probe);
+    std::error_code ignored;
+    fs::remove(link_, ignored);
+    fs::create_symlink(slave, link_);
+    appeared_ns_ = monotonic_ns();
+    reopen_reported_ = false;
+    std::printf("feed: %s device %s -> %s\n", name_.c_str(), link_.c_str(), slave);
+    std::fflush(stdout);
+  }
+  void vanish() {
+    if (master_ < 0) return;
+    std::error_code ignored;
+    fs::remove(link_, ignored);
+    ::close(master_);
+    master_ = -1;
+  }
+  // After a reappearance: prints once how long the reader took to open the device again.
+  void report_reopen(std::uint64_t generation) {
+    if (reopen_reported_ || generation == 0 || !reader_open()) return;
+    reopen_reported_ = true;
+    std::printf("feed: %s reopened by the reader %.3f s after it reappeared\n", name_.c_str(),
+                static_cast<double>(monotonic_ns() - appeared_ns_) * 1e-9);
+    std::fflush(stdout);
+  }
+
+ private:
+  std::string name_;
+  fs::path link_;
+  int master_ = -1;
+  std::int64_t appeared_ns_ = 0;
+  bool reopen_reported_ = false;
+};
+
+class UdpSender {
+ public:
+  explicit UdpSender(const std::string& from) {
+    sockaddr_in source{};
+    source.sin_family = AF_INET;
+    if (inet_pton(AF_INET, from.c_str(), &source.sin_addr) != 1 || (ntohl(source.sin_addr.s_addr) >> 24) != 127) {
+      throw std::invalid_argument("feed sends on loopback only: '" + from + "' is not a 127.x.y.z address");
+    }
+    fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    if (fd_ < 0 || ::bind(fd_, reinterpret_cast<const sockaddr*>(&source), sizeof source) != 0) {
+      throw std::runtime_error("UDP sender " + from + ": " + std::strerror(errno));
+    }
+  }
+  ~UdpSender() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  UdpSender(const UdpSender&) = delete;
+  UdpSender& operator=(const UdpSender&) = delete;
+  void send(std::span<const std::uint8_t> bytes, std::uint16_t port) {
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    to.sin_port = htons(port);
+    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    for (;;) {
+      const ssize_t n = ::sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
+      if (n >= 0 || errno != ENOBUFS) break;  // loopback: ENOBUFS only under pressure; retry
+    }
+    ++sent_;
+  }
+  [[nodiscard]] std::uint64_t sent() const noexcept { return sent_; }
+
+ private:
+  int fd_ = -1;
+  std::uint64_t sent_ = 0;
+};
+
+// One malformed datagram of several kinds, made from a real data packet.
+std::vector<std::uint8_t> malformed(std::span<const std::uint8_t> real, std::uint64_t k, std::mt19937& random) {
+  std::vector<std::uint8_t> out(real.begin(), real.end());
+  out.resize(1206);  // a data packet's size, whatever came in
+  switch (k % 5) {
+    case 0: out.resize(600); break;                  // wrong size
+    case 1: out.front() = 0x00; break;               // bad block flag
+    case 2: out.back() = 0x28; break;                // VLP-32C product id
+    case 3: out.resize(1400, 0xAB); break;           // oversize for a Velodyne packet
+    default:
+      for (auto& b : out) b = static_cast<std::uint8_t>(random());  // noise
+      break;
+  }
+  return out;
+}
+
+struct Stream {
+  std::optional<std::int64_t> t;  // recorded receive time of `bytes`
+  std::vector<std::uint8_t> bytes;
+  std::uint16_t port = 0;
+};
+
+void run_feed(const FeedOptions& o) {
+  if (!(o.rate > 0.0)) throw std::invalid_argument("--rate must be > 0");
+  if (o.foreign_every == 0) throw std::invalid_argument("--foreign-every must be >= 1");
+  const fs::path dir = o.run_dir;
+  vlp16::PcapOptions pcap_options;
+  pcap_options.ports = {vlp16::kDataPort, vlp16::kPositionPort};
+  vlp16::PcapSource pcap(dir / sim::kLidarFile, pcap_options);
+  std::unique_ptr<serial::ReplaySource> gnss_log, imu_log;
+  std::unique_ptr<PtyDevice> gnss_dev, imu_dev;
+  if (!o.gnss_link.empty()) {
+    gnss_log = std::make_unique<serial::ReplaySource>((dir / sim::kGnssFile).string());
+    gnss_dev = std::make_unique<PtyDevice>("gnss", o.gnss_link);
+  }
+  if (!o.imu_link.empty()) {
+    imu_log = std::make_unique<serial::ReplaySource>((dir / sim::kImuFile).string());
+    imu_dev = std::make_unique<PtyDevice>("imu", o.imu_link);
+  }
+  std::vector<Hangup> hangups;
+  for (const std::string& h : o.hangups) hangups.push_back(parse_hangup(h));
+  UdpSender sensor(o.from);
+  std::unique_ptr<UdpSender> foreign;
+  if (!o.foreign_from.empty()) foreign = std::make_unique<UdpSender>(o.foreign_from);
+
+  // The readers open their devices first (a daemon starting), then the clock starts.
+  const std::int64_t give_up = monotonic_ns() + static_cast<std::int64_t>(o.wait_for_readers_s * 1e9);
+  while ((gnss_dev && !gnss_dev->reader_open()) || (imu_dev && !imu_dev->reader_open())) {
+    if (monotonic_ns() > give_up) throw std::runtime_error("no reader opened the serial devices within --wait-for-readers");
+    sleep_until(monotonic_ns() + 10'000'000);
+  }
+
+  Stream lidar, gnss, imu;
+  vlp16::Datagram d;
+  const auto next_lidar = [&] {
+    lidar.t.reset();
+    if (pcap.next(d) == vlp16::PacketSource::Next::kDatagram) {
+      lidar.t = d.receive_time_ns;
+      lidar.bytes.assign(d.payload.begin(), d.payload.end());
+      lidar.port = d.destination_port == vlp16::kPositionPort ? o.position_port : o.data_port;
+    }
+  };
+  const auto next_serial = [](serial::ReplaySource* log, Stream& s) {
+    s.t.reset();
+    serial::Chunk chunk;
+    if (log != nullptr && log->read(chunk, std::chrono::milliseconds(0)) == serial::ReadStatus::kData) {
+      s.t = chunk.receive_time_ns;
+      s.bytes.assign(chunk.bytes.begin(), chunk.bytes.end());
+    }
+  };
+  next_lidar();
+  next_serial(gnss_log.get(), gnss);
+  next_serial(imu_log.get(), imu);
+  std::int64_t t0 = INT64_MAX;
+  for (const Stream* s : {&lidar, &gnss, &imu}) {
+    if (s->t) t0 = std::min(t0, *s->t);
+  }
+  if (t0 == INT64_MAX) throw std::runtime_error(dir.string() + ": nothing to feed");
+  // Recorded times are host monotonic (serial) and CLOCK_REALTIME (pcap) of the recording
+  // machine; both count from their first item here, which is what the daemon records too.
+  const std::int64_t start = monotonic_ns();
+  double data_s = 0.0;
+  std::uint64_t flood_sent = 0, malformed_sent = 0, foreign_sent = 0, data_sent = 0;
+  std::uint64_t serial_undelivered[2] = {0, 0};
+  std::uint64_t generation[2] = {0, 0};
+  std::vector<bool> hung(hangups.size(), false), back(hangups.size(), false);
+  std::mt19937 random(12345);
+  const double flood_extra = std::max(0.0, o.flood_factor - 1.0);
+  double flood_credit = 0.0;
+
+  for (;;) {
+    Stream* next = nullptr;
+    for (Stream* s : {&lidar, &gnss, &imu}) {
+      if (s->t && (next == nullptr || *s->t < *next->t)) next = s;
+    }
+    if (next == nullptr) break;
+    data_s = static_cast<double>(*next->t - t0) * 1e-9;
+    sleep_until(start + static_cast<std::int64_t>(static_cast<double>(*next->t - t0) / o.rate));
+
+    for (std::size_t i = 0; i < hangups.size(); ++i) {  // devices coming back
+      PtyDevice* dev = hangups[i].stream == "gnss" ? gnss_dev.get() : imu_dev.get();
+      if (dev != nullptr && hung[i] && !back[i] && data_s >= hangups[i].at_s + hangups[i].for_s) {
+        back[i] = true;
+        dev->appear();
+        ++generation[hangups[i].stream == "gnss" ? 0 : 1];
+      }
+    }
+    if (gnss_dev) gnss_dev->report_reopen(generation[0]);
+    if (imu_dev) imu_dev->report_reopen(generation[1]);
+
+    if (next == &lidar) {
+      sensor.send(lidar.bytes, lidar.port);
+      if (lidar.port == o.data_port) {
+        ++data_sent;
+        if (foreign && data_sent % o.foreign_every == 0) {
+          foreign->send(lidar.bytes, lidar.port);
+          ++foreign_sent;
+        }
+        if (o.flood_at_s >= 0.0 && data_s >= o.flood_at_s && data_s < o.flood_at_s + o.flood_for_s) {
+          flood_credit += flood_extra;
+          for (; flood_credit >= 1.0; flood_credit -= 1.0) {
+            if (std::uniform_real_distribution<double>(0.0, 1.0)(random) < o.malformed_fraction) {
+              sensor.send(malformed(lidar.bytes, malformed_sent++, random), o.data_port);
+            } else {
+              sensor.send(lidar.bytes, o.data_port);  // a copy: a duplicate to the decoder
+            }
+            ++flood_sent;
+          }
+        }
+      }
+      next_lidar();
+      continue;
+    }
+    const int k = next == &gnss ? 0 : 1;
+    PtyDevice& dev = k == 0 ? *gnss_dev : *imu_dev;
+    bool wrote = false;
+    for (std::size_t i = 0; i < hangups.size(); ++i) {
+      if (!hung[i] && hangups[i].stream == (k == 0 ? "gnss" : "imu") && data_s >= hangups[i].at_s) {
+        // Unplugged in the middle of this chunk: half of it goes out, then the device is gone.
+        hung[i] = true;
+        const std::size_t half = next->bytes.size() / 2;
+        dev.write(std::span<const std::uint8_t>(next->bytes.data(), half));
+        dev.vanish();
+        std::printf("feed: %s device vanished at %.3f s of data, %zu bytes into a %zu-byte chunk\n",
+                    k == 0 ? "gnss" : "imu", data_s, half, next->bytes.size());
+        std::fflush(stdout);
+        wrote = true;
+      }
+    }
+    if (!wrote && !dev.write(next->bytes)) ++serial_undelivered[k];
+    next_serial(k == 0 ? gnss_log.get() : imu_log.get(), *next);
+  }
+  std::printf("feed: done: %.3f s of data in %.3f s; UDP sent %llu (%llu data, %llu flood of which %llu malformed)"
+              " from %s, %llu from %s; serial chunks with no reader: gnss %llu, imu %llu\n",
+              data_s,
+              static_cast<double>(monotonic_ns() - start) * 1e-9, static_cast<unsigned long long>(sensor.sent()),
+              static_cast<unsigned long long>(data_sent), static_cast<unsigned long long>(flood_sent),
+              static_cast<unsigned long long>(malformed_sent), o.from.c_str(),
+              static_cast<unsigned long long>(foreign_sent), o.foreign_from.empty() ? "-" : o.foreign_from.c_str(),
+              static_cast<unsigned long long>(serial_undelivered[0]), static_cast<unsigned long long>(serial_undelivered[1]));
+  std::fflush(stdout);
+  sleep_until(monotonic_ns() + static_cast<std::int64_t>(o.linger_s * 1e9));
+}
+
+}  // namespace
+
+void add_feed_command(CLI::App& app) {
+  auto o = std::make_shared<FeedOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "feed", "Play a run folder into a live trajroid: UDP to 127.0.0.1, serial streams through pseudo-terminals");
+  cmd->add_option("run", o->run_dir, "Run folder (lidar.pcap, gnss.trjb, imu.trjb)")->required()->check(CLI::ExistingDirectory);
+  cmd->add_option("--rate", o->rate, "Pace: 1 real time, N × real time")->capture_default_str();
+  cmd->add_option("--data-port", o->data_port, "UDP port for data packets")->capture_default_str();
+  cmd->add_option("--position-port", o->position_port, "UDP port for position packets")->capture_default_str();
+  cmd->add_option("--from", o->from, "Loopback address the sensor sends from")->capture_default_str();
+  cmd->add_option("--gnss-link", o->gnss_link, "Symlink to create for the GNSS pseudo-terminal (the daemon's gnss.device)");
+  cmd->add_option("--imu-link", o->imu_link, "Symlink to create for the IMU pseudo-terminal (the daemon's imu.device)");
+  cmd->add_option("--wait-for-readers", o->wait_for_readers_s, "Seconds to wait for the devices to be opened")
+      ->capture_default_str();
+  cmd->add_option("--linger", o->linger_s, "Seconds the devices stay after the data ends")->capture_default_str();
+  cmd->add_option("--hangup", o->hangups, "STREAM@AT_S+FOR_S: the device vanishes mid-chunk, back FOR_S later");
+  cmd->add_option("--flood-at", o->flood_at_s, "Data time (s) a UDP flood starts");
+  cmd->add_option("--flood-for", o->flood_for_s, "Flood duration, s of data")->capture_default_str();
+  cmd->add_option("--flood-factor", o->flood_factor, "Flood rate as a multiple of the data packet rate")
+      ->capture_default_str();
+  cmd->add_option("--malformed-fraction", o->malformed_fraction, "Share of the flood that is malformed")
+      ->capture_default_str();
+  cmd->add_option("--foreign-from", o->foreign_from, "Also send copies from this loopback address (not the sensor)");
+  cmd->add_option("--foreign-every", o->foreign_every, "One copy from --foreign-from per this many data packets")
+      ->capture_default_str();
+  cmd->callback([o] { run_feed(*o); });
+}
+
+}  // namespace trajroi::cli
