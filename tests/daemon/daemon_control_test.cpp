@@ -25,7 +25,13 @@ trajroi::trajectory_t trajectory(std::int32_t id, std::vector<double> u, std::ve
 TEST(TrajroidControl, TrajectoryOverLcmSighupAndSigterm) {
   const std::string prefix = "TRJTEST_" + std::to_string(::getpid()) + "_CONTROL";
   const fs::path run = corridor_run();
+  // The trajectory file this daemon re-reads on SIGHUP: the run's, copied.
+  const fs::path trajectory_file = run / (prefix + "_trajectory.csv");
+  fs::copy_file(run / "trajectory.csv", trajectory_file, fs::copy_options::overwrite_existing);
   std::string text = slurp(run / "trajroid.yaml");
+  const auto at = text.find("file: trajectory.csv");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 20, "file: " + trajectory_file.filename().string());
   text += "lcm:\n  channels: {points: " + prefix + "_POINTS, pose: " + prefix + "_POSE, roi: " + prefix +
           "_ROI, status: " + prefix + "_STATUS, trajectory: " + prefix + "_TRAJECTORY}\n";
   const fs::path config = run / (prefix + ".yaml");
@@ -73,6 +79,32 @@ TEST(TrajroidControl, TrajectoryOverLcmSighupAndSigterm) {
       [&] { return listener.points.rbegin()->first > first_new && listener.points.rbegin()->second.trajectory_id == 0; },
       seconds(10)));
 
+  // Malformed files on SIGHUP: each refused with its reason in the log, the active
+  // trajectory (the configured one, id 0) stays.
+  const std::string good = slurp(trajectory_file);
+  std::string million;
+  million.reserve(14'000'000);
+  for (int i = 0; i <= 1'000'000; ++i) million += std::to_string(i) + ",0\n";  // one too many
+  const std::vector<std::pair<std::string, std::string>> bad{
+      {"0,0\n5,nan\n10,0\n", ":2: waypoint is not finite"},
+      {"0,0\n", "at least two distinct waypoints, got 1"},
+      {million, "1000001 waypoints, more than the limit of 1000000"},
+      {"0,0\n3,4,5\n", ":2: expected 'x,y'"}};
+  const fs::path log = run / (prefix + ".log");
+  for (std::size_t i = 0; i < bad.size(); ++i) {
+    std::ofstream(trajectory_file, std::ios::trunc) << bad[i].first;
+    const std::int64_t before = listener.points.rbegin()->first;
+    child.signal(SIGHUP);
+    ASSERT_TRUE(listener.wait_for([&] { return listener.points.rbegin()->first > before + 5; }, seconds(10)));
+    const std::string text_now = slurp(log);
+    const auto refused = text_now.rfind("SIGHUP: trajectory not reloaded");
+    ASSERT_NE(refused, std::string::npos) << text_now;
+    EXPECT_NE(text_now.find(bad[i].second, refused), std::string::npos) << text_now.substr(refused);
+    std::lock_guard<std::mutex> lock(listener.mutex);
+    EXPECT_EQ(listener.points.rbegin()->second.trajectory_id, 0);
+  }
+  std::ofstream(trajectory_file, std::ios::trunc) << good;
+
   // SIGTERM: a clean stop within a second.
   const auto asked = std::chrono::steady_clock::now();
   child.signal(SIGTERM);
@@ -91,6 +123,7 @@ TEST(TrajroidControl, TrajectoryOverLcmSighupAndSigterm) {
   EXPECT_EQ(counter(last, "trajectory.rejected: unknown coordinates"), 1);
   EXPECT_EQ(counter(last, "trajectory.accepted"), 1);
   EXPECT_EQ(counter(last, "trajectory.reloads"), 1);
+  EXPECT_EQ(counter(last, "trajectory.reload_errors"), 4);
   EXPECT_EQ(counter(last, "trajectory.swaps"), 2);
   EXPECT_EQ(last.ring_drops, 0);
   for (const auto& [idx, m] : listener.points) {
