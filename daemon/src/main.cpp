@@ -17,10 +17,11 @@ int main(int argc, char** argv) {
   CLI::App app{"trajroid: VLP-16 + u-blox + VN-100 in, trajectory-ROI-filtered points out over LCM"};
   std::string config_file;
   std::string replay, record, rate = "max", lcm_url;
-  bool check_config = false;
+  bool check_config = false, loop = false;
   app.add_option("--config", config_file, "YAML configuration (see config/trajroid.yaml)")->required();
   app.add_option("--replay", replay, "Replay a run folder (lidar.pcap, gnss.trjb, imu.trjb) instead of the sensors");
   app.add_option("--rate", rate, "Replay pace: realtime, max, or a factor of real time (e.g. 10)")->capture_default_str();
+  app.add_flag("--loop", loop, "With --replay: play the run again and again (times shifted each lap) until stopped");
   app.add_option("--record", record, "Record every raw input with its host receive time into this folder");
   app.add_option("--lcm-url", lcm_url, "LCM provider URL (overrides lcm.url)");
   app.add_flag("--check-config", check_config, "Check the configuration, print a summary and exit");
@@ -44,6 +45,11 @@ int main(int argc, char** argv) {
   RunOptions options;
   if (!replay.empty()) options.replay = replay;
   if (!record.empty()) options.record = record;
+  if (loop && replay.empty()) {
+    std::fprintf(stderr, "trajroid: --loop needs --replay\n");
+    return kExitConfig;
+  }
+  options.loop = loop;
   options.lcm_url = lcm_url;
   if (stall_after_s >= 0.0) options.stall_processing_after_s = stall_after_s;
   if (rate == "max") {

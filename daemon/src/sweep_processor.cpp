@@ -18,6 +18,9 @@ constexpr std::size_t kScratchPoints = 1024;       // more than one packet's 384
 // the shorter baselines are tried, and in the first 0.1 s none (the speed is unknown).
 constexpr std::array<std::int64_t, 3> kSpeedBaselines_ns{500'000'000, 200'000'000, 100'000'000};
 constexpr double kMaxAdvancePerSweep_m = 10.0;    // projection search window (50 m/s at 5 Hz)
+// Farther than this from the windowed projection, the robot is not where the window assumed
+// (its pose jumped: relocalised, carried, a replay looping): the whole trajectory is searched.
+constexpr double kReacquireDistance_m = 5.0;
 
 vlp16::Calibration load_calibration(const std::filesystem::path& file) {
   if (file.empty()) return vlp16::Calibration::vlp16_default();
@@ -195,8 +198,15 @@ void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
   }
 
   const roi::Trajectory& trajectory = active_->trajectory;
-  const roi::Projection p = have_hint_ ? trajectory.project(position, s_hint_m_, kMaxAdvancePerSweep_m)
-                                       : trajectory.project(position);
+  roi::Projection p = have_hint_ ? trajectory.project(position, s_hint_m_, kMaxAdvancePerSweep_m)
+                                 : trajectory.project(position);
+  if (have_hint_ && p.distance_m > kReacquireDistance_m) {
+    const roi::Projection anywhere = trajectory.project(position);
+    if (anywhere.distance_m < p.distance_m) {
+      p = anywhere;
+      ++counters_.projection_reacquired;
+    }
+  }
   s_hint_m_ = p.s_m;
   have_hint_ = true;
   // An unknown speed grows the ROI as the cap does: the larger region is the safe side.

@@ -172,6 +172,7 @@ class Daemon {
 
  private:
   void open_sources();
+  void open_replay(bool first);
   void lidar_live();
   void serial_live(serial::SerialPortSource& source, Ring<SerialItem>& ring, std::atomic<bool>& done,
                    const char* name, const ThreadConfig& thread);
@@ -186,6 +187,7 @@ class Daemon {
   void offer(std::unique_ptr<ActiveTrajectory> trajectory);
   void snapshot(bool final);
   void publish_status(lcm::LCM& lcm, const StatusSnapshot& s);
+  void log_minute(const StatusSnapshot& s);
   void warn_rate_limited(const std::string& message);
   [[nodiscard]] bool inputs_done() const noexcept {
     return lidar_done_.load(std::memory_order_acquire) && gnss_done_.load(std::memory_order_acquire) &&
@@ -249,7 +251,8 @@ class Daemon {
   // Publisher-owned.
   std::array<std::uint64_t, kTrajectoryRejectCount> trajectory_rejects_{};
   std::uint64_t trajectories_accepted_ = 0, trajectory_reloads_ = 0, trajectory_reload_errors_ = 0;
-  std::vector<double> latency_window_ms_, processing_window_ms_, latency_all_ms_;
+  std::vector<double> latency_window_ms_, processing_window_ms_, latency_all_ms_, latency_minute_ms_;
+  StatusSnapshot minute_start_;  // the status at the start of the current minute (log_minute)
   StatusSnapshot last_status_;
   std::int64_t start_steady_ns_ = 0;
   log::RateLimited warn_limit_;
@@ -266,22 +269,27 @@ void Daemon::warn_rate_limited(const std::string& message) {
   }
 }
 
+// The run folder's three recordings, from their start (again for each lap of --loop).
+void Daemon::open_replay(bool first) {
+  const fs::path& dir = *options_.replay;
+  vlp16::PcapOptions pcap_options;
+  pcap_options.ports = {vlp16::kDataPort, vlp16::kPositionPort};
+  pcap_ = std::make_unique<vlp16::PcapSource>(dir / kLidarFile, pcap_options);
+  const auto open_serial = [&](const char* name, std::atomic<bool>& done) -> std::unique_ptr<serial::ReplaySource> {
+    if (!fs::exists(dir / name)) {
+      if (first) log::warn("replay: {} absent: that stream is silent", (dir / name).string());
+      done.store(true);
+      return nullptr;
+    }
+    return std::make_unique<serial::ReplaySource>((dir / name).string());
+  };
+  gnss_replay_ = open_serial(kGnssFile, gnss_done_);
+  imu_replay_ = open_serial(kImuFile, imu_done_);
+}
+
 void Daemon::open_sources() {
   if (options_.replay) {
-    const fs::path& dir = *options_.replay;
-    vlp16::PcapOptions pcap_options;
-    pcap_options.ports = {vlp16::kDataPort, vlp16::kPositionPort};
-    pcap_ = std::make_unique<vlp16::PcapSource>(dir / kLidarFile, pcap_options);
-    const auto open_serial = [&dir](const char* name, std::atomic<bool>& done) -> std::unique_ptr<serial::ReplaySource> {
-      if (!fs::exists(dir / name)) {
-        log::warn("replay: {} absent: that stream is silent", (dir / name).string());
-        done.store(true);
-        return nullptr;
-      }
-      return std::make_unique<serial::ReplaySource>((dir / name).string());
-    };
-    gnss_replay_ = open_serial(kGnssFile, gnss_done_);
-    imu_replay_ = open_serial(kImuFile, imu_done_);
+    open_replay(true);
     return;
   }
   vlp16::UdpOptions udp;
@@ -398,6 +406,10 @@ void Daemon::replay() {
   };
   Pending lidar, gnss, imu;
   vlp16::Datagram d;
+  // --loop: added to every recorded time, one lap's span (plus a gap) more each lap.
+  constexpr std::int64_t kLapGap_ns = 100'000'000;
+  std::int64_t shift = 0, lap_first = INT64_MAX, lap_last = INT64_MIN;
+  std::uint64_t lap = 1;
   const auto next_lidar = [&] {
     for (;;) {
       const auto r = pcap_->next(d);
@@ -411,17 +423,17 @@ void Daemon::replay() {
         continue;
       }
       lidar.have = true;
-      lidar.t = d.receive_time_ns;
+      lidar.t = d.receive_time_ns + shift;
       lidar.port = d.destination_port == vlp16::kPositionPort ? LidarPort::kPosition : LidarPort::kData;
       lidar.bytes.assign(d.payload.begin(), d.payload.end());
       return;
     }
   };
-  const auto next_serial = [](serial::ReplaySource* source, Pending& p) {
+  const auto next_serial = [&shift](serial::ReplaySource* source, Pending& p) {
     serial::Chunk chunk;
     p.have = source != nullptr && source->read(chunk, milliseconds(0)) == serial::ReadStatus::kData;
     if (p.have) {
-      p.t = chunk.receive_time_ns;
+      p.t = chunk.receive_time_ns + shift;
       p.bytes.assign(chunk.bytes.begin(), chunk.bytes.end());
     }
   };
@@ -439,11 +451,25 @@ void Daemon::replay() {
   bool anchored = false;
   int unnotified = 0;
   std::int64_t t0 = 0, wall0 = 0;
-  while (!stop_.load(std::memory_order_relaxed) && (lidar.have || gnss.have || imu.have)) {
+  for (;;) {
+    if (!lidar.have && !gnss.have && !imu.have) {
+      if (!options_.loop || stop_.load(std::memory_order_relaxed) || lap_first > lap_last) break;
+      shift += lap_last - lap_first + kLapGap_ns;
+      lap_first = INT64_MAX;
+      lap_last = INT64_MIN;
+      open_replay(false);
+      next_lidar();
+      next_serial(gnss_replay_.get(), gnss);
+      next_serial(imu_replay_.get(), imu);
+      log::info("replay: lap {}", ++lap);
+      continue;
+    }
+    if (stop_.load(std::memory_order_relaxed)) break;
     Pending* p = nullptr;
     for (Pending* c : {&gnss, &imu, &lidar}) {
       if (c->have && (p == nullptr || c->t < p->t)) p = c;
     }
+    if (p == nullptr) break;  // cannot happen (one of them has an item); for the compiler
     if (paced) {
       if (!anchored) {
         anchored = true;
@@ -457,6 +483,8 @@ void Daemon::replay() {
       }
       if (due > steady_ns() + kPacingQuantum_ns) sleep_until_steady(due, stop_);
     }
+    lap_first = std::min(lap_first, p->t);
+    lap_last = std::max(lap_last, p->t);
     // As fast as possible: wait for room (exact output); paced: drop when full, as live.
     const bool notify = !paced;
     if (p == &lidar) {
@@ -532,6 +560,7 @@ void Daemon::snapshot(bool final) {
     s->add(vlp16::to_string(static_cast<vlp16::PacketError>(i)), l.rejected[i]);
   }
   s->add("lidar.out_of_order", l.out_of_order);
+  s->add("lidar.restarts", l.restarts);
   s->add("lidar.late_dropped", l.late_dropped);
   s->add("lidar.duplicates", l.duplicates);
   s->add("lidar.clock_resets", l.clock_resets);
@@ -567,6 +596,7 @@ void Daemon::snapshot(bool final) {
   s->add("pose.imu_clock_resets", in.imu_clock().resets());
   s->add("sweeps.points_truncated", p.counters().points_truncated);
   s->add("trajectory.swaps", p.counters().trajectory_swaps);
+  s->add("trajectory.projection_reacquired", p.counters().projection_reacquired);
   status_.publish();
   publish_wake_.notify();
 }
@@ -751,6 +781,36 @@ void Daemon::publish_status(lcm::LCM& lcm, const StatusSnapshot& s) {
   latency_window_ms_.clear();
   processing_window_ms_.clear();
   last_status_ = s;
+  if (minute_start_.steady_ns == 0) minute_start_ = s;
+  if (s.steady_ns - minute_start_.steady_ns >= 60'000'000'000 || s.final) log_minute(s);
+}
+
+// Once a minute, for the journal and soak tests: what the last minute did, and the memory.
+void Daemon::log_minute(const StatusSnapshot& s) {
+  const auto counter_value = [](const StatusSnapshot& snapshot, std::string_view name) -> std::uint64_t {
+    for (std::size_t i = 0; i < snapshot.counter_count; ++i) {
+      if (snapshot.counters[i].name == name) return snapshot.counters[i].value;
+    }
+    return 0;
+  };
+  long pages = 0;
+  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
+    long size = 0;
+    if (std::fscanf(f, "%ld %ld", &size, &pages) != 2) pages = 0;
+    std::fclose(f);
+  }
+  const double rss_mib = static_cast<double>(pages) * static_cast<double>(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
+  log::info("minute: {:.0f} s | sweeps {} published {} | latency p50 {:.2f} p99 {:.2f} max {:.2f} ms | ring drops {} | "
+            "kernel drops {} | lost packets {} | RSS {:.1f} MiB",
+            static_cast<double>(s.steady_ns - minute_start_.steady_ns) * 1e-9,
+            s.processor.sweeps - minute_start_.processor.sweeps,
+            s.processor.sweeps_filtered - minute_start_.processor.sweeps_filtered, percentile(latency_minute_ms_, 0.50),
+            percentile(latency_minute_ms_, 0.99), percentile(latency_minute_ms_, 1.0),
+            s.ring_drops() - minute_start_.ring_drops(),
+            counter_value(s, "lidar.kernel_drops") - counter_value(minute_start_, "lidar.kernel_drops"),
+            s.lost_packets - minute_start_.lost_packets, rss_mib);
+  latency_minute_ms_.clear();
+  minute_start_ = s;
 }
 
 void Daemon::publishing(lcm::LCM& lcm) {
@@ -759,6 +819,7 @@ void Daemon::publishing(lcm::LCM& lcm) {
   latency_window_ms_.reserve(4096);
   processing_window_ms_.reserve(4096);
   latency_all_ms_.reserve(1U << 20);
+  latency_minute_ms_.reserve(1U << 16);
   trajroi::points_t points;
   trajroi::pose_t pose;
   trajroi::roi_t roi;
@@ -781,6 +842,7 @@ void Daemon::publishing(lcm::LCM& lcm) {
         lcm.publish(config_.lcm.points, &points);
         const double latency_ms = static_cast<double>(steady_ns() - s->last_packet_arrival_ns) * 1e-6;
         if (latency_window_ms_.size() < latency_window_ms_.capacity()) latency_window_ms_.push_back(latency_ms);
+        if (latency_minute_ms_.size() < latency_minute_ms_.capacity()) latency_minute_ms_.push_back(latency_ms);
         if (latency_all_ms_.size() < latency_all_ms_.capacity()) latency_all_ms_.push_back(latency_ms);
       } else {
         warn_rate_limited("sweep " + std::to_string(s->index) + " withheld: no valid pose (" +

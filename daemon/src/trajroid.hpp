@@ -13,6 +13,9 @@ namespace trajroi::daemon {
 struct RunOptions {
   std::optional<std::filesystem::path> replay;  // a run folder: lidar.pcap, gnss.trjb, imu.trjb
   double rate = 0.0;                            // replay pace: 0 as fast as possible, 1 real time, N × real time
+  // Replay the run again and again until stopped (soak tests): each lap's recorded times are
+  // shifted to follow the previous lap's; the sensors' own clocks restart each lap.
+  bool loop = false;
   std::optional<std::filesystem::path> record;  // write every raw input here (same layout)
   std::string lcm_url;                          // overrides lcm.url when set
   // Fault injection for the watchdog test: after this many seconds the processing thread

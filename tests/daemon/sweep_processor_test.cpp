@@ -197,3 +197,48 @@ TEST(SweepProcessor, WithoutGnssNoSweepIsFilteredAndEachSaysWhy) {
 }
 
 }  // namespace
+
+namespace {
+
+// The robot's pose jumps back to the start of the trajectory (here: the run fed twice, the
+// second time shifted to follow the first, as `trajroid --replay --loop` does). Progress along
+// the trajectory may not go backwards, but a robot far from where it put it is searched for
+// again: the second pass places its ROI chains exactly as the first did.
+TEST(SweepProcessor, APoseJumpBackAlongTheTrajectoryIsFoundAgain) {
+  const auto& events = run_events();
+  const std::int64_t lap_ns = events.back().t_ns - events.front().t_ns + 100'000'000;
+  SweepProcessor processor(run_config(), trajectory_from(corridor_run() / "trajectory.csv", 0));
+  Collect sink;
+  for (const std::int64_t shift : {std::int64_t{0}, lap_ns}) {
+    for (const Event& e : events) {
+      if (e.kind == Event::kGnss) {
+        processor.gnss_bytes(e.bytes, e.t_ns + shift);
+      } else if (e.kind == Event::kImu) {
+        processor.imu_bytes(e.bytes, e.t_ns + shift);
+      } else {
+        processor.lidar_datagram(e.port, e.bytes, e.t_ns + shift, sink);
+      }
+    }
+  }
+  processor.flush(sink);
+  EXPECT_GE(processor.counters().projection_reacquired, 1u);
+  EXPECT_EQ(processor.lidar_counters().restarts, 1u);
+  // Sweeps of the second pass against the first, matched by start time within the lap: the
+  // same place on the trajectory (the first sweeps after the jump aside, whose speed and
+  // attitude history still spans it).
+  std::map<std::int64_t, const Sweep*> first;
+  for (const Sweep& s : sink.sweeps) {
+    if (s.filtered && s.start_ns < events.front().t_ns + lap_ns) first[s.start_ns / 10'000'000] = &s;
+  }
+  std::size_t compared = 0;
+  for (const Sweep& s : sink.sweeps) {
+    if (!s.filtered || s.start_ns < events.front().t_ns + lap_ns + 2'000'000'000) continue;
+    const auto a = first.find((s.start_ns - lap_ns) / 10'000'000);
+    if (a == first.end()) continue;
+    EXPECT_NEAR(s.start_s_m, a->second->start_s_m, 0.05) << s.start_ns;
+    ++compared;
+  }
+  EXPECT_GT(compared, 150u);
+}
+
+}  // namespace

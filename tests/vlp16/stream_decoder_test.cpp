@@ -187,6 +187,42 @@ TEST(Vlp16Stream, TopOfHourWrapIsNotALossNorAClockReset) {
   EXPECT_EQ(r.counters.decoded_packets, 2 * kPacketsPerTurn);
 }
 
+// The sensor's clock starts again (a power cycle, or a replay looping) while the receive
+// clock goes on: a restart, not 30 s of out-of-order packets; the new stream decodes whole.
+TEST(Vlp16Stream, SensorTimeJumpingBackIsARestartNotReordering) {
+  Sensor sensor;
+  sensor.toh_us = 31'000'000.0;
+  StreamDecoder decoder(Calibration::vlp16_default(), {});
+  Collector sink;
+  for (std::size_t i = 0; i < 3 * kPacketsPerTurn; ++i) {
+    if (i == 2 * kPacketsPerTurn + 20) sensor.toh_us -= 30'000'000.0;  // back 30 s, mid-sweep
+    auto p = sensor.next();
+    decoder.on_data_packet(p, sensor.received(), sink);
+  }
+  for (std::size_t i = 0; i < 3 * kPacketsPerTurn; ++i) {
+    auto p = sensor.next();
+    decoder.on_data_packet(p, sensor.received(), sink);
+  }
+  decoder.flush(sink);
+  const StreamCounters& c = decoder.counters();
+  EXPECT_EQ(c.restarts, 1u);
+  EXPECT_EQ(c.out_of_order, 0u);
+  EXPECT_EQ(c.late_dropped, 0u);
+  EXPECT_EQ(c.lost_packets, 0u);
+  EXPECT_EQ(c.decoded_packets, 6 * kPacketsPerTurn);
+  // Frames: 0 partial, 1 whole, 2 cut by the restart (partial), then the new stream: its first
+  // partial, whole turns, the last partial. Points go on in the receive clock.
+  ASSERT_GE(sink.frames.size(), 6u);
+  EXPECT_TRUE(sink.frames[2].partial);
+  EXPECT_EQ(sink.frames[2].points.size(), 20u * 384);
+  EXPECT_TRUE(sink.frames[3].partial);
+  for (std::size_t i = 4; i + 1 < sink.frames.size(); ++i) {
+    EXPECT_FALSE(sink.frames[i].partial) << i;
+    EXPECT_EQ(sink.frames[i].points.size(), kPacketsPerTurn * 384) << i;
+    EXPECT_GT(sink.frames[i].start_time_ns, sink.frames[i - 1].end_time_ns) << i;
+  }
+}
+
 TEST(Vlp16Stream, DualReturnStreamHasHalfThePeriod) {
   Sensor sensor;
   sensor.mode = ReturnMode::kDual;

@@ -106,6 +106,15 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
 
   std::uint32_t lost = 0;
   std::int64_t delta_us = 0;
+  if (have_last_ && toh_delta_us(last_toh_us_, toh) < -kRestartThreshold_us) {
+    // The sensor's clock started again: a new stream, whose first frame is partial.
+    ++counters_.restarts;
+    finish_frame(sink, true);
+    first_frame_ = true;
+    have_last_ = false;
+    have_phase_ = false;
+    rate_cdeg_per_us_ = 0.0;
+  }
   if (have_last_) {
     delta_us = toh_delta_us(last_toh_us_, toh);
     if (delta_us == 0) {

@@ -113,6 +113,7 @@ struct ProcessorCounters {
   std::uint64_t points_kept = 0;
   std::uint64_t points_truncated = 0;
   std::uint64_t trajectory_swaps = 0;
+  std::uint64_t projection_reacquired = 0;  // the robot far from where progress along the trajectory put it
 };
 
 class SweepProcessor {

@@ -15,7 +15,9 @@
 // dual), or, with a normal step, an azimuth advance beyond 1.5 × the expected one, counts
 // the packets in between as lost. A packet older than the previous one is counted out of
 // order and joins the current frame if it falls inside it; a repeated timestamp is a
-// duplicate and dropped.
+// duplicate and dropped. A timestamp more than kRestartThreshold_us behind the previous one
+// is no reordering but a sensor that restarted its clock (a power cycle, a replay looping):
+// the frame in progress ends (partial) and the stream starts afresh (counted as a restart).
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -32,6 +34,7 @@
 namespace trajroi::vlp16 {
 
 inline constexpr std::int64_t kClockResetThreshold_ns = 100'000'000;
+inline constexpr std::int64_t kRestartThreshold_us = 1'000'000;
 // A frame is cut after this long even without an azimuth wrap (a stalled motor): ten times
 // the slowest sweep (5 Hz).
 inline constexpr std::int64_t kMaxFrameDuration_ns = 2'000'000'000;
@@ -81,6 +84,7 @@ struct StreamCounters {
   std::uint64_t late_dropped = 0;      // out of order and older than the current frame
   std::uint64_t duplicates = 0;
   std::uint64_t clock_resets = 0;
+  std::uint64_t restarts = 0;          // sensor time jumped back by more than kRestartThreshold_us
   std::uint64_t points = 0;
   std::uint64_t no_return = 0;
   std::uint64_t out_of_range = 0;

@@ -1,0 +1,85 @@
+#!/usr/bin/env bash
+# Soak: trajroid replays a simulated run (tests/daemon/corridor.yaml, dual return) in a loop at
+# RATE × real time for MINUTES, publishing over LCM on loopback. Each minute it prints the
+# daemon's resident memory (from /proc), the sweeps, the latency percentiles (last packet of a
+# sweep → LCM publication), ring and kernel drops, as the daemon's own once-a-minute line
+# reports them. Passes when memory stays within 5 % of the first minute's and nothing is
+# dropped.
+# Usage: scripts/soak.sh [MINUTES=10] [RATE=10] [BUILD_DIR=build/release]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+minutes=${1:-10}
+rate=${2:-10}
+build=${3:-build/release}
+if [ ! -x "$build/daemon/trajroid" ] || [ ! -x "$build/tools/trajroi" ]; then
+  cmake --preset release >/dev/null
+  cmake --build "$build" --target trajroid trajroi
+fi
+work=$(mktemp -d)
+daemon_pid=
+cleanup() {
+  if [ -n "$daemon_pid" ]; then kill "$daemon_pid" 2>/dev/null || true; fi
+  rm -rf "$work"
+}
+trap cleanup EXIT
+"$build/tools/trajroi" sim --quiet --scenario tests/daemon/corridor.yaml --out "$work/run" >/dev/null
+lap_s=$(awk '/^duration_s/ {print $2}' "$work/run/summary.txt")
+# Own channel names: nothing else listening on this machine is disturbed.
+cp "$work/run/trajroid.yaml" "$work/run/soak.yaml"
+printf 'lcm:\n  channels: {points: SOAK_POINTS, pose: SOAK_POSE, roi: SOAK_ROI, status: SOAK_STATUS, trajectory: SOAK_TRAJECTORY}\n' \
+  >>"$work/run/soak.yaml"
+
+"$build/daemon/trajroid" --config "$work/run/soak.yaml" --replay "$work/run" --loop --rate "$rate" \
+  --lcm-url 'udpm://239.255.76.67:7667?ttl=0' 2>"$work/trajroid.log" &
+daemon_pid=$!
+echo "soak: corridor run (${lap_s} s of dual-return data a lap) looped at ${rate}x real time for ${minutes} min"
+printf '%-6s %9s %8s %9s %10s %10s %10s %10s %10s\n' minute "RSS MiB" sweeps published "p50 ms" "p99 ms" "max ms" \
+  "ring drop" "kern drop"
+rss_mib() { awk '/^VmRSS:/ {printf "%.1f", $2 / 1024}' "/proc/$daemon_pid/status"; }
+rss=()
+seen=0
+for ((m = 1; m <= minutes; ++m)); do
+  # The daemon logs its minute line once a minute of status; wait for the m-th.
+  until [ "$(grep -c ' minute: ' "$work/trajroid.log" || true)" -ge "$m" ]; do
+    if ! kill -0 "$daemon_pid" 2>/dev/null; then
+      echo "soak: trajroid ended early:" >&2
+      tail -20 "$work/trajroid.log" >&2
+      exit 1
+    fi
+    sleep 1
+  done
+  r=$(rss_mib)
+  rss+=("$r")
+  line=$(grep ' minute: ' "$work/trajroid.log" | sed -n "${m}p")
+  seen=$m
+  awk -v m="$m" -v r="$r" '{
+      for (i = 1; i <= NF; ++i) {
+        if ($i == "sweeps") sweeps = $(i + 1)
+        if ($i == "published") published = $(i + 1)
+        if ($i == "p50") p50 = $(i + 1)
+        if ($i == "p99") p99 = $(i + 1)
+        if ($i == "max") max = $(i + 1)
+        if ($i == "ring") ring = $(i + 2)
+        if ($i == "kernel") kern = $(i + 2)
+      }
+      printf "%-6s %9s %8s %9s %10s %10s %10s %10s %10s\n", m, r, sweeps, published, p50, p99, max, ring, kern
+    }' <<<"$line"
+done
+kill -TERM "$daemon_pid"
+wait "$daemon_pid" || true
+daemon_pid=
+summary=$(grep 'summary:' "$work/trajroid.log" || true)
+echo "soak: $(sed 's/.*summary: //' <<<"$summary")"
+laps=$(grep -c 'replay: lap' "$work/trajroid.log" || true)
+echo "soak: $((laps + 1)) laps; lidar restarts at each lap boundary are the replay looping, not a fault"
+drops=$(grep ' minute: ' "$work/trajroid.log" | head -n "$seen" |
+  awk '{for (i = 1; i <= NF; ++i) {if ($i == "ring") r += $(i + 2); if ($i == "kernel") k += $(i + 2)}} END {print r + k}')
+awk -v first="${rss[0]}" -v last="${rss[${#rss[@]} - 1]}" -v drops="$drops" -v all="${rss[*]}" 'BEGIN {
+  n = split(all, v, " "); lo = v[1]; hi = v[1]
+  for (i = 2; i <= n; ++i) { if (v[i] < lo) lo = v[i]; if (v[i] > hi) hi = v[i] }
+  growth = 100 * (hi - first) / first
+  printf "soak: RSS first minute %.1f MiB, last %.1f MiB, range %.1f … %.1f MiB (%+.1f %% of the first; goal within 5 %%); drops %d (goal 0)\n", first, last, lo, hi, growth, drops
+  ok = (growth <= 5 && (first - lo) / first * 100 <= 5 && drops == 0)
+  print ok ? "soak: PASS" : "soak: FAIL"
+  exit !ok
+}'
