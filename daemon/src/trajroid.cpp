@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "items.hpp"
+#include "trajroi/daemon/latency_histogram.hpp"
 #include "log.hpp"
 #include "realtime.hpp"
 #include "trajroi/daemon/messages.hpp"
@@ -251,7 +252,8 @@ class Daemon {
   // Publisher-owned.
   std::array<std::uint64_t, kTrajectoryRejectCount> trajectory_rejects_{};
   std::uint64_t trajectories_accepted_ = 0, trajectory_reloads_ = 0, trajectory_reload_errors_ = 0;
-  std::vector<double> latency_window_ms_, processing_window_ms_, latency_all_ms_, latency_minute_ms_;
+  std::vector<double> latency_window_ms_, processing_window_ms_, latency_minute_ms_;
+  LatencyHistogram latency_all_;  // the whole run, for the summary
   StatusSnapshot minute_start_;  // the status at the start of the current minute (log_minute)
   StatusSnapshot last_status_;
   std::int64_t start_steady_ns_ = 0;
@@ -818,7 +820,6 @@ void Daemon::publishing(lcm::LCM& lcm) {
   transport::subscribe_raw<&Daemon::on_trajectory_message>(lcm, config_.lcm.trajectory, this);
   latency_window_ms_.reserve(4096);
   processing_window_ms_.reserve(4096);
-  latency_all_ms_.reserve(1U << 20);
   latency_minute_ms_.reserve(1U << 16);
   trajroi::points_t points;
   trajroi::pose_t pose;
@@ -843,7 +844,7 @@ void Daemon::publishing(lcm::LCM& lcm) {
         const double latency_ms = static_cast<double>(steady_ns() - s->last_packet_arrival_ns) * 1e-6;
         if (latency_window_ms_.size() < latency_window_ms_.capacity()) latency_window_ms_.push_back(latency_ms);
         if (latency_minute_ms_.size() < latency_minute_ms_.capacity()) latency_minute_ms_.push_back(latency_ms);
-        if (latency_all_ms_.size() < latency_all_ms_.capacity()) latency_all_ms_.push_back(latency_ms);
+        latency_all_.add(latency_ms);
       } else {
         warn_rate_limited("sweep " + std::to_string(s->index) + " withheld: no valid pose (" +
                           std::string(pose::to_string(s->pose_status)) + ")");
@@ -1034,7 +1035,7 @@ int Daemon::run() {
             wall_s, s.processor.sweeps, s.processor.sweeps_filtered, s.processor.sweeps_without_pose, s.processor.points_in,
             s.processor.points_kept,
             s.processor.points_in > 0 ? 100.0 * static_cast<double>(s.processor.points_kept) / static_cast<double>(s.processor.points_in) : 0.0,
-            percentile(latency_all_ms_, 0.5), percentile(latency_all_ms_, 0.99), latency_all_ms_.size(), drops,
+            latency_all_.quantile(0.5), latency_all_.quantile(0.99), latency_all_.count(), drops,
             s.lost_packets, s.decode_errors);
   log::info("cpu: sources {:.3f} s ({}), processing {:.3f} s, publishing {:.3f} s",
             static_cast<double>(cpu_sources_ns_.load()) * 1e-9, options_.replay ? "replay reader" : "receive threads",
