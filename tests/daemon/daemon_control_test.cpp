@@ -93,7 +93,11 @@ TEST(TrajroidControl, TrajectoryOverLcmSighupAndSigterm) {
   const fs::path log = run / (prefix + ".log");
   for (std::size_t i = 0; i < bad.size(); ++i) {
     std::ofstream(trajectory_file, std::ios::trunc) << bad[i].first;
-    const std::int64_t before = listener.points.rbegin()->first;
+    std::int64_t before = 0;
+    {
+      std::lock_guard<std::mutex> lock(listener.mutex);
+      before = listener.points.rbegin()->first;
+    }
     child.signal(SIGHUP);
     ASSERT_TRUE(listener.wait_for([&] { return listener.points.rbegin()->first > before + 5; }, seconds(10)));
     const std::string text_now = slurp(log);
