@@ -19,6 +19,8 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <condition_variable>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -189,6 +191,9 @@ class Daemon {
   void snapshot(bool final);
   void publish_status(lcm::LCM& lcm, const StatusSnapshot& s);
   void log_minute(const StatusSnapshot& s);
+  void reloading();
+  void request_reload();
+  void take_reloads();
   void warn_rate_limited(const std::string& message);
   [[nodiscard]] bool inputs_done() const noexcept {
     return lidar_done_.load(std::memory_order_acquire) && gnss_done_.load(std::memory_order_acquire) &&
@@ -239,7 +244,17 @@ class Daemon {
   std::unique_ptr<Ring<SerialItem>> record_gnss_, record_imu_;
 
   EventFd process_wake_, publish_wake_, record_wake_, main_wake_;
-  std::atomic<bool> stop_{false}, reload_{false};
+  std::atomic<bool> stop_{false};
+  // SIGHUP reloads: requested by the main thread, read by reloading(), taken by the publisher.
+  struct Reload {
+    std::unique_ptr<ActiveTrajectory> trajectory;  // or why not
+    std::string error;
+  };
+  std::mutex reload_mutex_;
+  std::condition_variable reload_cv_;
+  std::uint64_t reload_requests_ = 0;
+  bool reload_stop_ = false;
+  std::vector<Reload> reloads_;
   std::atomic<bool> lidar_done_{false}, gnss_done_{false}, imu_done_{false};
   std::atomic<bool> processing_done_{false}, publishing_done_{false};
   std::atomic<std::uint64_t> processing_beat_{0}, publishing_beat_{0};
@@ -863,16 +878,7 @@ void Daemon::publishing(lcm::LCM& lcm) {
       t->trajectory.reset();
       trajectories_out_.release();
     }
-    if (reload_.exchange(false)) {
-      try {
-        offer(load_trajectory(config_.trajectory_file));
-        ++trajectory_reloads_;
-        log::info("SIGHUP: trajectory reloaded from {}; active from the next sweep", config_.trajectory_file.string());
-      } catch (const std::exception& e) {
-        ++trajectory_reload_errors_;
-        log::error("SIGHUP: trajectory not reloaded, the active one stays: {}", e.what());
-      }
-    }
+    take_reloads();
     if (processing_done_.load(std::memory_order_acquire) && sweeps_.size() == 0 && status_.size() == 0 &&
         (final_seen || stop_.load(std::memory_order_relaxed))) {
       break;
@@ -881,6 +887,57 @@ void Daemon::publishing(lcm::LCM& lcm) {
   cpu_publishing_ns_.fetch_add(thread_cpu_ns());
   publishing_done_.store(true, std::memory_order_release);
   main_wake_.notify();
+}
+
+// SIGHUP re-reads the trajectory file on this thread, off the publishing thread: reading and
+// checking a large file (up to a million waypoints) must not hold up publication. Requests
+// that come while a file is being read are served by one more read afterwards.
+void Daemon::reloading() {
+  pthread_setname_np(pthread_self(), "trajroid-reload");
+  std::unique_lock<std::mutex> lock(reload_mutex_);
+  for (;;) {
+    reload_cv_.wait(lock, [this] { return reload_requests_ > 0 || reload_stop_; });
+    if (reload_stop_) return;
+    reload_requests_ = 0;
+    lock.unlock();
+    Reload r;
+    try {
+      r.trajectory = load_trajectory(config_.trajectory_file);
+    } catch (const std::exception& e) {
+      r.error = e.what();
+    }
+    lock.lock();
+    reloads_.push_back(std::move(r));
+    publish_wake_.notify();
+  }
+}
+
+void Daemon::request_reload() {
+  {
+    std::lock_guard<std::mutex> lock(reload_mutex_);
+    ++reload_requests_;
+  }
+  reload_cv_.notify_one();
+}
+
+// Publisher: offers what the reload thread loaded (the mutex is held for a vector swap only).
+void Daemon::take_reloads() {
+  std::vector<Reload> done;
+  {
+    std::lock_guard<std::mutex> lock(reload_mutex_);
+    if (reloads_.empty()) return;
+    done.swap(reloads_);
+  }
+  for (Reload& r : done) {
+    if (r.trajectory) {
+      offer(std::move(r.trajectory));
+      ++trajectory_reloads_;
+      log::info("SIGHUP: trajectory reloaded from {}; active from the next sweep", config_.trajectory_file.string());
+    } else {
+      ++trajectory_reload_errors_;
+      log::error("SIGHUP: trajectory not reloaded, the active one stays: {}", r.error);
+    }
+  }
 }
 
 // ---- recording ------------------------------------------------------------------------------
@@ -973,6 +1030,7 @@ int Daemon::run() {
   const int sfd = signalfd(-1, &signals, SFD_NONBLOCK | SFD_CLOEXEC);
 
   std::vector<std::thread> threads;
+  std::thread reload_thread([this] { reloading(); });
   threads.emplace_back([this] { processing(); });
   threads.emplace_back([this, &lcm] { publishing(lcm); });
   if (options_.record) threads.emplace_back([this] { recording(); });
@@ -1004,8 +1062,7 @@ int Daemon::run() {
       while (read(sfd, &info, sizeof info) == static_cast<ssize_t>(sizeof info)) {
         if (info.ssi_signo == SIGHUP) {
           log::info("SIGHUP: reloading the trajectory");
-          reload_.store(true);
-          publish_wake_.notify();
+          request_reload();
         } else {
           log::info("{}: stopping", info.ssi_signo == SIGTERM ? "SIGTERM" : "SIGINT");
           sd_notify(0, "STOPPING=1");
@@ -1025,6 +1082,12 @@ int Daemon::run() {
   }
   stop_.store(true);
   for (std::thread& t : threads) t.join();
+  {
+    std::lock_guard<std::mutex> lock(reload_mutex_);
+    reload_stop_ = true;
+  }
+  reload_cv_.notify_one();
+  reload_thread.join();
   close(sfd);
 
   const StatusSnapshot& s = last_status_;
