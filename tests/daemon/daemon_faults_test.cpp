@@ -98,6 +98,17 @@ std::int64_t count_after(const std::string& log, const std::string& prefix, std:
   return static_cast<std::int64_t>(number_after(log, prefix, from));
 }
 
+// Once the feeder has printed its closing line (it lingers, the devices still there): lets the
+// last sweep and status out, then stops the daemon, which must exit 0.
+testing::AssertionResult stop_after_feed(const LiveRig& rig, Child& daemon, std::chrono::milliseconds timeout) {
+  if (!wait_for_feed_done(rig, timeout)) return testing::AssertionFailure() << "the feed did not end\n" << rig.logs();
+  std::this_thread::sleep_for(milliseconds(1500));
+  daemon.signal(SIGTERM);
+  const int code = daemon.wait(seconds(5));
+  if (code != 0) return testing::AssertionFailure() << "trajroid exited with " << code << "\n" << rig.logs();
+  return testing::AssertionSuccess();
+}
+
 long rss_kb(pid_t pid) {
   std::ifstream in("/proc/" + std::to_string(pid) + "/status");
   std::string line;
@@ -127,10 +138,7 @@ TEST(TrajroidFaults, SerialDevicesUnpluggedMidFrameAreReopenedWithinASecond) {
   ASSERT_TRUE(listener.good());
   Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
   Child feed(TRAJROI_CLI, rig.feed_args(run, {"--hangup", "gnss@5+2", "--hangup", "imu@9+1"}), rig.feed_log);
-  ASSERT_TRUE(wait_for_feed_done(rig, seconds(60))) << rig.logs();
-  std::this_thread::sleep_for(milliseconds(1500));  // the last sweep and status out
-  daemon.signal(SIGTERM);
-  ASSERT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+  ASSERT_TRUE(stop_after_feed(rig, daemon, seconds(60)));
 
   const std::string log = slurp(rig.feed_log);
   for (const char* stream : {"gnss", "imu"}) {
@@ -175,10 +183,7 @@ TEST(TrajroidFaults, GnssDegradedThenLostForTenSecondsStopsAndResumesFilteredSwe
   ASSERT_TRUE(listener.good());
   Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
   Child feed(TRAJROI_CLI, rig.feed_args(run, {}), rig.feed_log);
-  ASSERT_TRUE(wait_for_feed_done(rig, seconds(60))) << rig.logs();
-  std::this_thread::sleep_for(milliseconds(1500));
-  daemon.signal(SIGTERM);
-  ASSERT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+  ASSERT_TRUE(stop_after_feed(rig, daemon, seconds(60)));
 
   // The configured pose timeout (pose.max_extrapolation_s) and one sweep (0.1 s) to notice.
   constexpr double kTimeout = 0.25, kSweep = 0.1, kLossFrom = 8.0, kLossTo = 18.0;
@@ -238,10 +243,7 @@ TEST(TrajroidFaults, UdpFloodWithMalformedPacketsIsCountedBoundedAndRecoveredFro
     if (newest >= 50) peak_kb = std::max(peak_kb, kb);
     std::this_thread::sleep_for(milliseconds(100));
   }
-  ASSERT_TRUE(wait_for_feed_done(rig, seconds(1))) << rig.logs();
-  std::this_thread::sleep_for(milliseconds(1500));
-  daemon.signal(SIGTERM);
-  ASSERT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+  ASSERT_TRUE(stop_after_feed(rig, daemon, seconds(1)));
 
   const std::string log = slurp(rig.feed_log);
   // "UDP sent N (D data, F flood of which M malformed) from 127.0.0.1, X from 127.0.0.2"
