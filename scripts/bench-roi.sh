@@ -1,20 +1,34 @@
 #!/usr/bin/env bash
-# Runs the ROI benchmarks (medians of repeated runs) and prints the issue's goals as ratios
-# measured in the same run. Usage: scripts/bench-roi.sh [build dir]   (default build/release)
+# Runs the ROI benchmarks (medians of repeated runs, interleaved in random order so that a
+# slow spell of a shared machine falls on all of them alike) and prints the issue's goals as
+# ratios measured in the same run. Usage: scripts/bench-roi.sh [build dir]   (default build/release)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build/release}
 out=$(mktemp)
 trap 'rm -f "$out"' EXIT
-"$build/bench/roi_bench" --benchmark_min_time=0.5 --benchmark_repetitions=7 \
+"$build/bench/roi_bench" --benchmark_min_time=0.5 --benchmark_repetitions=7 --benchmark_enable_random_interleaving=true \
   --benchmark_report_aggregates_only=true --benchmark_format=console 2>/dev/null |
   awk '/_median/ { name = $1; sub(/_median$/, "", name); t = $2; if ($3 == "us") t /= 1000; print name, t }' >"$out"
 
 awk '
-  { ms[$1] = $2; order[++n] = $1 }
+  { ms[$1] = $2 }
   END {
+    # Interleaved runs report in random order; print in the order of the issue.
     printf "%-44s %12s\n", "benchmark (median)", "time [ms]"
-    for (k = 1; k <= n; ++k) printf "%-44s %12.4f\n", order[k], ms[order[k]]
+    split("frame accumulated", wheres, " "); split("circular rectangular", shapes, " ")
+    split("25 10", ratios, " "); split("reference fast", methods, " ")
+    for (w = 1; w <= 2; ++w) {
+      for (r = 1; r <= 2; ++r) for (s = 1; s <= 2; ++s) for (m = 1; m <= 2; ++m) {
+        name = "roi/" shapes[s] "/" methods[m] "/" wheres[w] "/" ratios[r]
+        if (name in ms) printf "%-44s %12.4f\n", name, ms[name]
+      }
+      split("read memcpy", limits, " ")
+      for (l = 1; l <= 2; ++l) {
+        name = "limit/" limits[l] "/" wheres[w]
+        if (name in ms) printf "%-44s %12.4f\n", name, ms[name]
+      }
+    }
     printf "\nGoals on the accumulated cloud (2.88 M points), same run:\n"
     fails = 0
     split("circular rectangular", shapes, " ")

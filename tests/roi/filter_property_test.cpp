@@ -122,7 +122,8 @@ void expect_equal(const RoiSet& set, const std::vector<Point>& points, Totals& t
   GridFilter<RoiSet> grid;
   grid.build(set);
   // Float clouds have vector scans; each must agree with the reference on its own.
-  for (const SimdPath path : {SimdPath::kAuto, SimdPath::kAvx2, SimdPath::kSse2, SimdPath::kScalar}) {
+  for (const SimdPath path : {SimdPath::kAuto, SimdPath::kAvx512, SimdPath::kAvx2, SimdPath::kSse2,
+                              SimdPath::kScalar}) {
     grid.filter(std::span<const Point>(points), fast, path);
     ASSERT_EQ(ref.size(), fast.size()) << label << " path " << static_cast<int>(path);
     ASSERT_EQ(ref, fast) << label << " path " << static_cast<int>(path);

@@ -20,7 +20,7 @@
 
 namespace trajroi::roi {
 
-enum class SimdPath : unsigned char { kAuto, kAvx2, kSse2, kScalar };
+enum class SimdPath : unsigned char { kAuto, kAvx512, kAvx2, kSse2, kScalar };
 
 // The float nearest to v on the given side (v itself when exactly representable).
 [[nodiscard]] inline float float_at_or_below(double v) noexcept {
@@ -72,7 +72,8 @@ class GridFilter {
 
   // `path` chooses the implementation of the per-point scan for PointXYZI clouds (other point
   // types always take the scalar path); every path gives the same result. kAuto takes the
-  // widest the CPU supports; the others exist so tests can check each one.
+  // widest the CPU supports; the others exist so tests can check each one (a path the CPU
+  // lacks falls back to the next narrower one).
   template <typename Point>
   FilterStats filter(std::span<const Point> points, IndexVector& kept,
                      SimdPath path = SimdPath::kAuto) const;
@@ -99,6 +100,8 @@ class GridFilter {
   std::size_t scan_sse2(std::span<const PointXYZI> points, Scan& scan) const;
   __attribute__((target("avx2,popcnt"))) std::size_t scan_avx2(std::span<const PointXYZI> points,
                                                                Scan& scan) const;
+  __attribute__((target("avx512f,popcnt"))) std::size_t scan_avx512(
+      std::span<const PointXYZI> points, Scan& scan) const;
 #endif
 
   // 0/1: is the point (x, y) in a cell with this value kept? Tests candidates for boundary cells.
@@ -341,7 +344,10 @@ FilterStats GridFilter<RoiSet>::filter(std::span<const Point> points, IndexVecto
   std::size_t i = 0;
   if constexpr (std::is_same_v<Point, PointXYZI>) {
 #if defined(__x86_64__) || defined(__i386__)
-    if ((path == SimdPath::kAuto || path == SimdPath::kAvx2) && __builtin_cpu_supports("avx2")) {
+    const bool wide = path == SimdPath::kAuto || path == SimdPath::kAvx512;
+    if (wide && __builtin_cpu_supports("avx512f")) {
+      i = scan_avx512(points, scan);
+    } else if ((wide || path == SimdPath::kAvx2) && __builtin_cpu_supports("avx2")) {
       i = scan_avx2(points, scan);
     } else if (path != SimdPath::kScalar) {
       i = scan_sse2(points, scan);
@@ -462,10 +468,11 @@ struct Avx2Grid {
   const int* cells;
 };
 
-// The cell values of the eight points at `p` (x, y, z, intensity each), in point order;
-// `clean` is false when one of them is non-finite or outside the z limits.
+// The cells (indices into the cell table) of the eight points at `p` (x, y, z, intensity
+// each), in point order, the sentinel for off-grid points; `clean` is false when one of them
+// is non-finite or outside the z limits.
 struct Avx2Block {
-  __m256i value;
+  __m256i cell;
   bool clean;
 };
 
@@ -505,16 +512,34 @@ __attribute__((target("avx2"), always_inline)) inline Avx2Block avx2_block(const
                                           _mm256_castps_si256(on_grid));
   // The transposition left the points in lane order 0 2 4 6 1 3 5 7; put them back.
   const __m256i natural = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
-  return {_mm256_i32gather_epi32(g.cells, _mm256_permutevar8x32_epi32(cell, natural), 4),
-          _mm256_movemask_ps(pass) == 0xff};
+  return {_mm256_permutevar8x32_epi32(cell, natural), _mm256_movemask_ps(pass) == 0xff};
 }
 
-// Writes the indices first … first + 7 whose cell value is 1 (inside) to out, packed;
-// returns how many. All eight values must be 0 or 1. Writes eight slots at `out`.
+// A LiDAR cloud in firing order brings the same laser back every block or two, and its
+// consecutive returns mostly land in the same cell: the scans keep the cells and values of
+// an earlier block and gather only the lanes whose cell has changed (none, most of the
+// time). Any order gives the same result; this one only makes it cheaper.
+struct Avx2Reuse {
+  __m256i cell;
+  __m256i value;  // the cell table's entries for `cell`
+};
+
+__attribute__((target("avx2"), always_inline)) inline __m256i avx2_values(__m256i cell,
+                                                                         Avx2Reuse& reuse,
+                                                                         const int* cells) {
+  const __m256i same = _mm256_cmpeq_epi32(cell, reuse.cell);
+  if (_mm256_movemask_ps(_mm256_castsi256_ps(same)) != 0xff) {
+    reuse.value = _mm256_mask_i32gather_epi32(reuse.value, cells, cell,
+                                              _mm256_xor_si256(same, _mm256_set1_epi32(-1)), 4);
+    reuse.cell = cell;
+  }
+  return reuse.value;
+}
+
+// Writes the indices first … first + 7 whose bit is set in `keep` to out, packed; returns
+// how many. Writes eight slots at `out`.
 __attribute__((target("avx2,popcnt"), always_inline)) inline std::size_t avx2_emit(
-    __m256i value, std::size_t first, std::uint32_t* out) {
-  const __m256i one = _mm256_set1_epi32(1);
-  const auto keep = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(value, one))));
+    unsigned keep, std::size_t first, std::uint32_t* out) {
   const __m256i indices = _mm256_add_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(first)),
                                            _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
   const __m256i packed = _mm256_permutevar8x32_epi32(
@@ -523,12 +548,18 @@ __attribute__((target("avx2,popcnt"), always_inline)) inline std::size_t avx2_em
   return static_cast<std::size_t>(__builtin_popcount(keep));
 }
 
-__attribute__((target("avx2"), always_inline)) inline void avx2_store(__m256i value, std::uint32_t* out) {
-  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), value);
+// Lane masks of the values equal to 1 (inside) and above 1 (boundary ids).
+__attribute__((target("avx2"), always_inline)) inline unsigned avx2_inside(__m256i value) {
+  return static_cast<unsigned>(
+      _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(value, _mm256_set1_epi32(1)))));
+}
+__attribute__((target("avx2"), always_inline)) inline unsigned avx2_boundary(__m256i value) {
+  return static_cast<unsigned>(
+      _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(value, _mm256_set1_epi32(1)))));
 }
 
-__attribute__((target("avx2"), always_inline)) inline bool avx2_any_boundary(__m256i value) {
-  return _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(value, _mm256_set1_epi32(1)))) != 0;
+__attribute__((target("avx2"), always_inline)) inline void avx2_store(__m256i value, std::uint32_t* out) {
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), value);
 }
 }  // namespace detail
 
@@ -552,40 +583,178 @@ __attribute__((target("avx2,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx2
   const float* const base = &points.data()->x;
   std::uint32_t* const out = scan.out;
   std::size_t count = scan.count;
-  std::uint32_t cell_value[8];
-  // Slow paths of one block: a point to reject (the scalar code counts why), or points in
-  // boundary cells (their candidates are tested), with the block's cell values in cell_value.
-  auto slow_block = [&](std::size_t first, bool clean) {
-    if (!clean) {
+  // Keeps the block's inside points and those of its boundary points a candidate ROI
+  // accepts, in order. A block with a point to reject goes to the scalar code, which counts
+  // why. Since count ≤ first, an 8-slot store at out + count stays within first + 8 ≤ n.
+  auto finish = [&](std::size_t first, const detail::Avx2Block& block, detail::Avx2Reuse& reuse)
+                    __attribute__((target("avx2,popcnt"))) {
+    if (!block.clean) [[unlikely]] {
       scan.count = count;
       for (std::size_t k = first; k < first + 8; ++k) scalar_point(points, k, scan);
       count = scan.count;
       return;
     }
-    for (std::size_t k = 0; k < 8; ++k) {
-      out[count] = static_cast<std::uint32_t>(first + k);
-      count += decide(cell_value[k], static_cast<double>(points[first + k].x),
-                      static_cast<double>(points[first + k].y));
+    const __m256i value = detail::avx2_values(block.cell, reuse, grid.cells);
+    unsigned keep = detail::avx2_inside(value);
+    unsigned boundary = detail::avx2_boundary(value);
+    if (boundary != 0) [[unlikely]] {
+      std::uint32_t cell_value[8];
+      detail::avx2_store(value, cell_value);
+      for (; boundary != 0; boundary &= boundary - 1) {
+        const auto k = static_cast<unsigned>(__builtin_ctz(boundary));
+        keep |= decide(cell_value[k], static_cast<double>(points[first + k].x),
+                       static_cast<double>(points[first + k].y)) << k;
+      }
     }
+    count += detail::avx2_emit(keep, first, out + count);
   };
-  auto finish = [&](std::size_t first, const detail::Avx2Block& block) __attribute__((target("avx2,popcnt"))) {
-    if (block.clean && !detail::avx2_any_boundary(block.value)) [[likely]] {
-      count += detail::avx2_emit(block.value, first, out + count);
-      return;
-    }
-    detail::avx2_store(block.value, cell_value);
-    slow_block(first, block.clean);
-  };
-  // Two blocks per step, so both gathers are in flight before either result is used. Since
-  // count ≤ first, an 8-slot store at out + count stays within the first + 8 ≤ n slots.
+  // Two blocks per step (the first and second half of a VLP-16 firing), each reusing the
+  // values of the same half one step earlier. All reused cells start as the sentinel.
+  detail::Avx2Reuse first_half{grid.sentinel, _mm256_setzero_si256()};
+  detail::Avx2Reuse second_half = first_half;
   std::size_t i = 0;
   for (; i + 16 <= points.size(); i += 16) {
     const detail::Avx2Block a = detail::avx2_block(base + 4 * i, grid);
     const detail::Avx2Block b = detail::avx2_block(base + 4 * (i + 8), grid);
-    finish(i, a);
-    finish(i + 8, b);
+    finish(i, a, first_half);
+    finish(i + 8, b, second_half);
   }
-  for (; i + 8 <= points.size(); i += 8) finish(i, detail::avx2_block(base + 4 * i, grid));
+  for (; i + 8 <= points.size(); i += 8) finish(i, detail::avx2_block(base + 4 * i, grid), first_half);
+  scan.count = count;
+  return i;
+}
+
+namespace detail {
+// What the AVX-512 scan needs to locate sixteen points' cells.
+struct Avx512Grid {
+  __m512 x0, y0, inv, nx_f, ny_f, z_lo, z_hi;
+  __m512i nx_i, sentinel;
+  bool z_limited;
+  const int* cells;
+};
+
+// As Avx2Block, for sixteen points.
+struct Avx512Block {
+  __m512i cell;
+  bool clean;
+};
+
+__attribute__((target("avx512f"), always_inline)) inline Avx512Block avx512_block(
+    const float* p, const Avx512Grid& g) {
+  const __m512 a = _mm512_loadu_ps(p);       // points 0–3
+  const __m512 b = _mm512_loadu_ps(p + 16);  // points 4–7
+  const __m512 c = _mm512_loadu_ps(p + 32);  // points 8–11
+  const __m512 d = _mm512_loadu_ps(p + 48);  // points 12–15
+  // x of eight points in lanes 0–7 and their y in lanes 8–15; then z (and intensity).
+  const __m512i xy = _mm512_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28, 1, 5, 9, 13, 17, 21, 25, 29);
+  const __m512i zw = _mm512_setr_epi32(2, 6, 10, 14, 18, 22, 26, 30, 3, 7, 11, 15, 19, 23, 27, 31);
+  const __m512 xy_ab = _mm512_permutex2var_ps(a, xy, b);
+  const __m512 xy_cd = _mm512_permutex2var_ps(c, xy, d);
+  const __m512 zw_ab = _mm512_permutex2var_ps(a, zw, b);
+  const __m512 zw_cd = _mm512_permutex2var_ps(c, zw, d);
+  const __m512i low = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 16, 17, 18, 19, 20, 21, 22, 23);
+  const __m512i high = _mm512_add_epi32(low, _mm512_set1_epi32(8));
+  const __m512 px = _mm512_permutex2var_ps(xy_ab, low, xy_cd);
+  const __m512 py = _mm512_permutex2var_ps(xy_ab, high, xy_cd);
+  const __m512 pz = _mm512_permutex2var_ps(zw_ab, low, zw_cd);
+  const __m512 max_finite = _mm512_set1_ps(std::numeric_limits<float>::max());
+  __mmask16 pass = _mm512_cmp_ps_mask(_mm512_abs_ps(px), max_finite, _CMP_LE_OQ) &
+                   _mm512_cmp_ps_mask(_mm512_abs_ps(py), max_finite, _CMP_LE_OQ) &
+                   _mm512_cmp_ps_mask(_mm512_abs_ps(pz), max_finite, _CMP_LE_OQ);
+  if (g.z_limited) {
+    pass = _mm512_kand(pass, _mm512_kand(_mm512_cmp_ps_mask(pz, g.z_lo, _CMP_GE_OQ),
+                                         _mm512_cmp_ps_mask(pz, g.z_hi, _CMP_LE_OQ)));
+  }
+  const __m512 zero = _mm512_setzero_ps();
+  const __m512 fx = _mm512_mul_ps(_mm512_sub_ps(px, g.x0), g.inv);
+  const __m512 fy = _mm512_mul_ps(_mm512_sub_ps(py, g.y0), g.inv);
+  const __mmask16 on_grid =
+      _mm512_cmp_ps_mask(fx, zero, _CMP_GE_OQ) & _mm512_cmp_ps_mask(fx, g.nx_f, _CMP_LT_OQ) &
+      _mm512_cmp_ps_mask(fy, zero, _CMP_GE_OQ) & _mm512_cmp_ps_mask(fy, g.ny_f, _CMP_LT_OQ);
+  // On-grid values are ≥ 0 (truncation floors).
+  const __m512i ix = _mm512_maskz_cvttps_epi32(on_grid, fx);
+  const __m512i iy = _mm512_maskz_cvttps_epi32(on_grid, fy);
+  const __m512i cell = _mm512_add_epi32(_mm512_mullo_epi32(iy, g.nx_i), ix);
+  return {_mm512_mask_blend_epi32(on_grid, g.sentinel, cell), pass == 0xffff};
+}
+
+// As Avx2Reuse: the cells and values of the previous block (one VLP-16 firing earlier).
+struct Avx512Reuse {
+  __m512i cell;
+  __m512i value;
+};
+
+__attribute__((target("avx512f"), always_inline)) inline __m512i avx512_values(__m512i cell,
+                                                                             Avx512Reuse& reuse,
+                                                                             const int* cells) {
+  const __mmask16 changed = _mm512_cmpneq_epi32_mask(cell, reuse.cell);
+  if (changed != 0) {
+    reuse.value = _mm512_mask_i32gather_epi32(reuse.value, changed, cell, cells, 4);
+    reuse.cell = cell;
+  }
+  return reuse.value;
+}
+}  // namespace detail
+
+template <typename RoiSet>
+__attribute__((target("avx512f,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx512(
+    std::span<const PointXYZI> points, Scan& scan) const {
+  static_assert(kOutside == 0 && kInside == 1);
+  if (points.size() < 16) return 0;
+  const FloatZLimits z = float_z_limits(rois_->z_limits());
+  const detail::Avx512Grid grid{_mm512_set1_ps(x0_),
+                                _mm512_set1_ps(y0_),
+                                _mm512_set1_ps(inv_cell_),
+                                _mm512_set1_ps(static_cast<float>(nx_)),
+                                _mm512_set1_ps(static_cast<float>(ny_)),
+                                _mm512_set1_ps(z.lo),
+                                _mm512_set1_ps(z.hi),
+                                _mm512_set1_epi32(static_cast<std::int32_t>(nx_)),
+                                _mm512_set1_epi32(static_cast<std::int32_t>(cells_.size() - 1)),
+                                z.limited,
+                                reinterpret_cast<const int*>(cells_.data())};
+  const float* const base = &points.data()->x;
+  std::uint32_t* const out = scan.out;
+  std::size_t count = scan.count;
+  detail::Avx512Reuse reuse{grid.sentinel, _mm512_setzero_si512()};  // the sentinel reads 0
+  const __m512i one = _mm512_set1_epi32(1);
+  const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  // Keeps the block's inside points and those of its boundary points that a candidate ROI
+  // accepts, in order. A block with a point to reject goes to the scalar code, which counts
+  // why. Since count ≤ first, a 16-slot store at out + count stays within first + 16 ≤ n.
+  auto finish = [&](std::size_t first, const detail::Avx512Block& block)
+                    __attribute__((target("avx512f,popcnt"))) {
+    if (!block.clean) [[unlikely]] {
+      scan.count = count;
+      for (std::size_t k = first; k < first + 16; ++k) scalar_point(points, k, scan);
+      count = scan.count;
+      return;
+    }
+    const __m512i cell_value = detail::avx512_values(block.cell, reuse, grid.cells);
+    auto keep = static_cast<unsigned>(_mm512_cmpeq_epi32_mask(cell_value, one));
+    auto boundary = static_cast<unsigned>(_mm512_cmpgt_epu32_mask(cell_value, one));
+    if (boundary != 0) [[unlikely]] {
+      alignas(64) std::uint32_t value[16];
+      _mm512_store_si512(value, cell_value);
+      for (; boundary != 0; boundary &= boundary - 1) {
+        const auto k = static_cast<unsigned>(__builtin_ctz(boundary));
+        keep |= decide(value[k], static_cast<double>(points[first + k].x),
+                       static_cast<double>(points[first + k].y)) << k;
+      }
+    }
+    const __m512i indices = _mm512_add_epi32(_mm512_set1_epi32(static_cast<std::int32_t>(first)), lane);
+    _mm512_storeu_si512(out + count, _mm512_maskz_compress_epi32(static_cast<__mmask16>(keep), indices));
+    count += static_cast<std::size_t>(__builtin_popcount(keep));
+  };
+  // Two blocks per step: both are located before either is looked up.
+  std::size_t i = 0;
+  for (; i + 32 <= points.size(); i += 32) {
+    const detail::Avx512Block a = detail::avx512_block(base + 4 * i, grid);
+    const detail::Avx512Block b = detail::avx512_block(base + 4 * (i + 16), grid);
+    finish(i, a);
+    finish(i + 16, b);
+  }
+  for (; i + 16 <= points.size(); i += 16) finish(i, detail::avx512_block(base + 4 * i, grid));
   scan.count = count;
   return i;
 }

@@ -174,4 +174,69 @@ class CorridorRoiSet {
   std::vector<double> ax_, ay_, dx_, dy_, length2_;
 };
 
+// ----------------------------------------------------------------------------------------
+// Cell relations, inline: GridFilter::build() calls them for every (ROI, cell) pair.
+namespace detail {
+// Squared distance from (px, py) to the box: 0 inside it.
+inline double box_distance2(const Box& b, double px, double py) noexcept {
+  const double dx = std::max({b.x_min - px, 0.0, px - b.x_max});
+  const double dy = std::max({b.y_min - py, 0.0, py - b.y_max});
+  return dx * dx + dy * dy;
+}
+
+// Squared distance from (px, py) to the farthest point of the box.
+inline double box_far_distance2(const Box& b, double px, double py) noexcept {
+  const double dx = std::max(px - b.x_min, b.x_max - px);
+  const double dy = std::max(py - b.y_min, b.y_max - py);
+  return dx * dx + dy * dy;
+}
+
+// Range of the linear function f(p) = e·(p − o) over a box: its value at the box's centre
+// plus or minus its largest change towards a corner.
+struct SlabRange {
+  double min;
+  double max;
+};
+
+inline SlabRange slab_range(double ox, double oy, double ex, double ey, const Box& cell) noexcept {
+  const double mx = 0.5 * (cell.x_min + cell.x_max);
+  const double my = 0.5 * (cell.y_min + cell.y_max);
+  const double centre = ex * (mx - ox) + ey * (my - oy);
+  const double reach = std::abs(ex) * 0.5 * (cell.x_max - cell.x_min) +
+                       std::abs(ey) * 0.5 * (cell.y_max - cell.y_min);
+  return {centre - reach, centre + reach};
+}
+
+}  // namespace detail
+
+inline CellRelation CircularRoiSet::relation(std::size_t j, const Box& cell,
+                                      double tolerance_m) const noexcept {
+  if (std::sqrt(detail::box_far_distance2(cell, cx_[j], cy_[j])) <= radius_m_ - tolerance_m) {
+    return CellRelation::kInside;
+  }
+  if (std::sqrt(detail::box_distance2(cell, cx_[j], cy_[j])) > radius_m_ + tolerance_m) {
+    return CellRelation::kOutside;
+  }
+  return CellRelation::kBoundary;
+}
+
+inline CellRelation RectangularRoiSet::relation(std::size_t j, const Box& cell,
+                                         double tolerance_m) const noexcept {
+  const RectGeometry& g = rects_[j];
+  // f1 = AB·(p − A) ∈ [0, ‖AB‖²] and f2 = BC·(p − B) ∈ [0, ‖BC‖²]; f / ‖e‖ is a distance, so
+  // a margin of tolerance_m metres is tolerance_m · ‖e‖ in f units.
+  // The margin also absorbs the rounding of the centre-based range (a few ulps of f).
+  const double tol1 = tolerance_m * g.ab;
+  const double tol2 = tolerance_m * g.bc;
+  const detail::SlabRange f1 = detail::slab_range(g.ax, g.ay, g.abx, g.aby, cell);
+  const detail::SlabRange f2 = detail::slab_range(g.bx, g.by, g.bcx, g.bcy, cell);
+  if (f1.max < -tol1 || f1.min > g.ab2 + tol1 || f2.max < -tol2 || f2.min > g.bc2 + tol2) {
+    return CellRelation::kOutside;
+  }
+  if (f1.min >= tol1 && f1.max <= g.ab2 - tol1 && f2.min >= tol2 && f2.max <= g.bc2 - tol2) {
+    return CellRelation::kInside;
+  }
+  return CellRelation::kBoundary;
+}
+
 }  // namespace trajroi::roi
