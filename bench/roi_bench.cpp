@@ -4,8 +4,12 @@
 // Names: roi/<circular|rectangular>/<reference|fast>/<frame|accumulated>/<25|10>
 //        limit/<read|memcpy>/<frame|accumulated>
 // Each fast iteration rebuilds the grid, as the daemon does for every sweep.
+// TRAJROI_SIMD=avx512|avx2|sse2|scalar forces the fast filter's scan (default: the widest the
+// CPU has), to measure what a CPU without AVX-512 would see.
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -32,6 +36,24 @@ const std::vector<roi::PointXYZI>& cloud(bool accumulated) {
   }();
   static const std::vector<roi::PointXYZI> many = accumulated_cloud(100);
   return accumulated ? many : frame;
+}
+
+roi::SimdPath simd_path() {
+  static const roi::SimdPath path = [] {
+    const char* name = std::getenv("TRAJROI_SIMD");
+    const std::string wanted = name == nullptr ? "" : name;
+    if (wanted == "avx512") return roi::SimdPath::kAvx512;
+    if (wanted == "avx2") return roi::SimdPath::kAvx2;
+    if (wanted == "sse2") return roi::SimdPath::kSse2;
+    if (wanted == "scalar") return roi::SimdPath::kScalar;
+    if (!wanted.empty() && wanted != "auto") {
+      std::fprintf(stderr, "roi_bench: TRAJROI_SIMD=%s is not auto, avx512, avx2, sse2 or scalar\n",
+                   wanted.c_str());
+      std::exit(2);
+    }
+    return roi::SimdPath::kAuto;
+  }();
+  return path;
 }
 
 const roi::Trajectory& trajectory() {
@@ -90,7 +112,7 @@ void fast(benchmark::State& state, bool accumulated, int ratio_pct) {
   kept.reserve(points.size());
   for (auto _ : state) {
     grid.build(set);
-    grid.filter(std::span<const roi::PointXYZI>(points), kept);
+    grid.filter(std::span<const roi::PointXYZI>(points), kept, simd_path());
     benchmark::DoNotOptimize(kept.data());
     benchmark::ClobberMemory();
   }
@@ -121,6 +143,7 @@ void limit_memcpy(benchmark::State& state, bool accumulated) {
 }
 
 int register_all() {
+  (void)simd_path();  // a bad TRAJROI_SIMD stops here, before any run
   for (const bool accumulated : {false, true}) {
     const std::string where = accumulated ? "accumulated" : "frame";
     const auto unit = accumulated ? benchmark::kMillisecond : benchmark::kMicrosecond;
