@@ -363,8 +363,10 @@ FilterStats GridFilter<RoiSet>::filter(std::span<const Point> points, IndexVecto
 // Vector scans over PointXYZI clouds. A PointXYZI is exactly one 16-byte vector (x, y, z,
 // intensity); the scans compute the cell of each point with the same float operations as
 // cell_index(), so every path assigns every point the same cell. A block in which a point is
-// non-finite or outside the z limits, or lies in a boundary cell, is handed to the scalar
-// code point by point. Both return the index of the first point they did not process.
+// non-finite or outside the z limits is handed to the scalar code point by point (which
+// counts the rejections); points in boundary cells are decided by decide() one by one — in
+// the SSE2 scan for the whole block, in the AVX2 and AVX-512 scans for those lanes only. All
+// return the index of the first point they did not process.
 #if defined(__x86_64__) || defined(__i386__)
 template <typename RoiSet>
 std::size_t GridFilter<RoiSet>::scan_sse2(std::span<const PointXYZI> points, Scan& scan) const {
