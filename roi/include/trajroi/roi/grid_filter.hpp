@@ -104,6 +104,17 @@ class GridFilter {
       std::span<const PointXYZI> points, Scan& scan) const;
 #endif
 
+#if defined(__x86_64__) || defined(__i386__)
+  // For the vector scans. The points first … first + n − 1 one by one, `count` indices
+  // written so far; returns the new count.
+  std::size_t scalar_block(std::span<const PointXYZI> points, std::size_t first, std::size_t n,
+                           Scan& scan, std::size_t count) const;
+  // Bit k set for each lane k of `boundary` whose point first + k is kept, given the lanes'
+  // cell values.
+  [[nodiscard]] unsigned decide_lanes(unsigned boundary, const std::uint32_t* value,
+                                      std::span<const PointXYZI> points, std::size_t first) const;
+#endif
+
   // 0/1: is the point (x, y) in a cell with this value kept? Tests candidates for boundary cells.
   [[nodiscard, gnu::always_inline]] inline std::uint32_t decide(std::uint32_t cell, double x, double y) const noexcept;
   // Index into cells_ of the cell holding (x, y); the sentinel when off the grid.
@@ -402,9 +413,7 @@ std::size_t GridFilter<RoiSet>::scan_sse2(std::span<const PointXYZI> points, Sca
                              _mm_cmple_ps(_mm_and_ps(pz, abs_mask), max_finite));
     if (z_limited) pass = _mm_and_ps(pass, _mm_and_ps(_mm_cmpge_ps(pz, lo), _mm_cmple_ps(pz, hi)));
     if (_mm_movemask_ps(pass) != 0xf) [[unlikely]] {
-      scan.count = count;
-      for (std::size_t k = i; k < i + 4; ++k) scalar_point(points, k, scan);
-      count = scan.count;
+      count = scalar_block(points, i, 4, scan, count);
       continue;
     }
     const __m128 fx = _mm_mul_ps(_mm_sub_ps(px, x0), inv);
@@ -442,6 +451,27 @@ std::size_t GridFilter<RoiSet>::scan_sse2(std::span<const PointXYZI> points, Sca
   }
   scan.count = count;
   return i;
+}
+
+template <typename RoiSet>
+std::size_t GridFilter<RoiSet>::scalar_block(std::span<const PointXYZI> points, std::size_t first,
+                                             std::size_t n, Scan& scan, std::size_t count) const {
+  scan.count = count;
+  for (std::size_t k = first; k < first + n; ++k) scalar_point(points, k, scan);
+  return scan.count;
+}
+
+template <typename RoiSet>
+unsigned GridFilter<RoiSet>::decide_lanes(unsigned boundary, const std::uint32_t* value,
+                                          std::span<const PointXYZI> points,
+                                          std::size_t first) const {
+  unsigned keep = 0;
+  for (; boundary != 0; boundary &= boundary - 1) {
+    const auto k = static_cast<unsigned>(__builtin_ctz(boundary));
+    keep |= decide(value[k], static_cast<double>(points[first + k].x),
+                   static_cast<double>(points[first + k].y)) << k;
+  }
+  return keep;
 }
 
 namespace detail {
@@ -591,22 +621,15 @@ __attribute__((target("avx2,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx2
   auto finish = [&](std::size_t first, const detail::Avx2Block& block, detail::Avx2Reuse& reuse)
                     __attribute__((target("avx2,popcnt"))) {
     if (!block.clean) [[unlikely]] {
-      scan.count = count;
-      for (std::size_t k = first; k < first + 8; ++k) scalar_point(points, k, scan);
-      count = scan.count;
+      count = scalar_block(points, first, 8, scan, count);
       return;
     }
     const __m256i value = detail::avx2_values(block.cell, reuse, grid.cells);
     unsigned keep = detail::avx2_inside(value);
-    unsigned boundary = detail::avx2_boundary(value);
-    if (boundary != 0) [[unlikely]] {
+    if (const unsigned boundary = detail::avx2_boundary(value); boundary != 0) [[unlikely]] {
       std::uint32_t cell_value[8];
       detail::avx2_store(value, cell_value);
-      for (; boundary != 0; boundary &= boundary - 1) {
-        const auto k = static_cast<unsigned>(__builtin_ctz(boundary));
-        keep |= decide(cell_value[k], static_cast<double>(points[first + k].x),
-                       static_cast<double>(points[first + k].y)) << k;
-      }
+      keep |= decide_lanes(boundary, cell_value, points, first);
     }
     count += detail::avx2_emit(keep, first, out + count);
   };
@@ -727,22 +750,16 @@ __attribute__((target("avx512f,popcnt"))) std::size_t GridFilter<RoiSet>::scan_a
   auto finish = [&](std::size_t first, const detail::Avx512Block& block)
                     __attribute__((target("avx512f,popcnt"))) {
     if (!block.clean) [[unlikely]] {
-      scan.count = count;
-      for (std::size_t k = first; k < first + 16; ++k) scalar_point(points, k, scan);
-      count = scan.count;
+      count = scalar_block(points, first, 16, scan, count);
       return;
     }
     const __m512i cell_value = detail::avx512_values(block.cell, reuse, grid.cells);
     auto keep = static_cast<unsigned>(_mm512_cmpeq_epi32_mask(cell_value, one));
-    auto boundary = static_cast<unsigned>(_mm512_cmpgt_epu32_mask(cell_value, one));
-    if (boundary != 0) [[unlikely]] {
+    if (const auto boundary = static_cast<unsigned>(_mm512_cmpgt_epu32_mask(cell_value, one));
+        boundary != 0) [[unlikely]] {
       alignas(64) std::uint32_t value[16];
       _mm512_store_si512(value, cell_value);
-      for (; boundary != 0; boundary &= boundary - 1) {
-        const auto k = static_cast<unsigned>(__builtin_ctz(boundary));
-        keep |= decide(value[k], static_cast<double>(points[first + k].x),
-                       static_cast<double>(points[first + k].y)) << k;
-      }
+      keep |= decide_lanes(boundary, value, points, first);
     }
     const __m512i indices = _mm512_add_epi32(_mm512_set1_epi32(static_cast<std::int32_t>(first)), lane);
     _mm512_storeu_si512(out + count, _mm512_maskz_compress_epi32(static_cast<__mmask16>(keep), indices));
