@@ -88,6 +88,8 @@ class GridFilter {
   static constexpr std::uint32_t kOutside = 0;
   static constexpr std::uint32_t kInside = 1;
   static constexpr std::uint32_t kFirstBoundary = 2;  // cell value = boundary id + 2
+  // The scans add a cell's value to the count and read an all-zero register as outside.
+  static_assert(kOutside == 0 && kInside == 1);
 
   struct Scan {
     std::uint32_t* out;   // room for every point
@@ -102,9 +104,6 @@ class GridFilter {
                                                                Scan& scan) const;
   __attribute__((target("avx512f,popcnt"))) std::size_t scan_avx512(
       std::span<const PointXYZI> points, Scan& scan) const;
-#endif
-
-#if defined(__x86_64__) || defined(__i386__)
   // For the vector scans. The points first … first + n − 1 one by one, `count` indices
   // written so far; returns the new count.
   std::size_t scalar_block(std::span<const PointXYZI> points, std::size_t first, std::size_t n,
@@ -724,7 +723,6 @@ __attribute__((target("avx512f"), always_inline)) inline __m512i avx512_values(_
 template <typename RoiSet>
 __attribute__((target("avx512f,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx512(
     std::span<const PointXYZI> points, Scan& scan) const {
-  static_assert(kOutside == 0 && kInside == 1);
   if (points.size() < 16) return 0;
   const FloatZLimits z = float_z_limits(rois_->z_limits());
   const detail::Avx512Grid grid{_mm512_set1_ps(x0_),
