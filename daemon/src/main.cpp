@@ -3,13 +3,12 @@
 
 #include <cstdio>
 #include <exception>
-#include <fstream>
+#include <memory>
 #include <optional>
-#include <sstream>
 #include <string>
 
 #include "log.hpp"
-#include "trajroi/roi/trajectory.hpp"
+#include "reload.hpp"
 #include "trajroid.hpp"
 
 int main(int argc, char** argv) {
@@ -66,13 +65,10 @@ int main(int argc, char** argv) {
       return kExitConfig;
     }
   }
+  // The trajectory file is part of the configuration: read once, here.
+  std::unique_ptr<ActiveTrajectory> trajectory;
   try {
-    // The trajectory file is part of the configuration: checked here, loaded again at start.
-    std::ifstream in(config.trajectory_file, std::ios::binary);
-    if (!in) throw std::runtime_error("cannot be read");
-    std::ostringstream text;
-    text << in.rdbuf();
-    (void)trajroi::roi::parse_trajectory_csv(text.str(), config.trajectory_file.string());
+    trajectory = load_trajectory(config.trajectory_file);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "trajroid: configuration error: %s: trajectory.file: %s: %s\n", config_file.c_str(),
                  config.trajectory_file.c_str(), e.what());
@@ -86,7 +82,7 @@ int main(int argc, char** argv) {
   }
   log::init(config.logging.level);
   try {
-    return run_daemon(config, options);
+    return run_daemon(config, std::move(trajectory), options);
   } catch (const std::exception& e) {
     log::critical("fatal: {}", e.what());
     return 1;

@@ -1,14 +1,20 @@
 #pragma once
 
-// The daemon's wiring: sources, rings, threads, LCM, signals, systemd. The logic lives in the
-// libraries (SweepProcessor, the drivers, the pose library).
+// The daemon's wiring: the sources, the pipeline's rings and threads, signals, systemd notify
+// and watchdog. Each thread's loop lives in a file of its own (threads.hpp, publisher.hpp).
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 
 #include "trajroi/daemon/config.hpp"
 
 namespace trajroi::daemon {
+
+struct Pipeline;
+class SweepProcessor;
+struct ActiveTrajectory;
+class Outlet;
 
 struct RunOptions {
   std::optional<std::filesystem::path> replay;  // a run folder: lidar.pcap, gnss.trjb, imu.trjb
@@ -23,11 +29,13 @@ struct RunOptions {
   std::optional<double> stall_processing_after_s;
 };
 
-inline constexpr const char* kLidarFile = "lidar.pcap";
-inline constexpr const char* kGnssFile = "gnss.trjb";
-inline constexpr const char* kImuFile = "imu.trjb";
-
 // Runs until SIGTERM / SIGINT, or the end of a replay. Returns the process exit code.
-int run_daemon(const DaemonConfig& config, const RunOptions& options);
+int run_daemon(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> trajectory, const RunOptions& options);
+
+// The pipeline's threads over the inputs already added to `pipeline`, until the inputs end or
+// `pipeline.stop` is set (by SIGTERM / SIGINT when `signals`; SIGHUP then reloads the
+// trajectory). Logs the summary; returns the exit code. What run_daemon and the tests call.
+int run_pipeline(Pipeline& pipeline, SweepProcessor& processor, Outlet& outlet, const RunOptions& options,
+                 bool signals);
 
 }  // namespace trajroi::daemon

@@ -17,13 +17,10 @@ TEST(SpscRing, HoldsItsCapacityInOrderAndCountsWhatDidNotFit) {
   SpscRing<int> ring(5);
   EXPECT_EQ(ring.capacity(), 8u);  // rounded up to a power of two
   for (int i = 0; i < 8; ++i) {
-    int* slot = ring.try_claim();
-    ASSERT_NE(slot, nullptr) << i;
-    *slot = i;
-    ring.publish();
+    ASSERT_TRUE(ring.try_push([i](int& slot) { slot = i; })) << i;
   }
   EXPECT_EQ(ring.try_claim(), nullptr);
-  ring.count_drop();
+  EXPECT_FALSE(ring.try_push([](int& slot) { slot = 99; }));
   EXPECT_EQ(ring.dropped(), 1u);
   EXPECT_EQ(ring.size(), 8u);
   for (int i = 0; i < 8; ++i) {
@@ -44,18 +41,17 @@ struct Payload {
 TEST(SpscRing, TwoThreadsPassTwoMillionItemsWithoutLossTearingOrReordering) {
   SpscRing<Payload> ring(64);
   constexpr std::uint64_t kItems = 2'000'000;
+  const std::atomic<bool> never{false};
   std::thread producer([&] {
-    for (std::uint64_t i = 0; i < kItems;) {
-      Payload* slot = ring.try_claim();
-      if (slot == nullptr) {
-        // A full ring: this test retries instead of dropping.
-        std::this_thread::yield();
-        continue;
-      }
-      slot->sequence = i;
-      slot->copies.fill(i);
-      ring.publish();
-      ++i;
+    for (std::uint64_t i = 0; i < kItems; ++i) {
+      // A full ring is waited on: nothing may be lost.
+      const bool pushed = ring.push_wait(
+          [i](Payload& slot) {
+            slot.sequence = i;
+            slot.copies.fill(i);
+          },
+          never, [] { std::this_thread::yield(); });
+      if (!pushed) return;
     }
   });
   std::uint64_t expected = 0;
@@ -74,6 +70,22 @@ TEST(SpscRing, TwoThreadsPassTwoMillionItemsWithoutLossTearingOrReordering) {
   producer.join();
   EXPECT_EQ(expected, kItems);
   EXPECT_EQ(torn, 0u);
+  EXPECT_EQ(ring.dropped(), 0u);
+}
+
+TEST(SpscRing, AWaitingPushGivesUpWhenStoppedAndCountsTheDrop) {
+  SpscRing<int> ring(2);
+  ASSERT_TRUE(ring.try_push([](int& v) { v = 1; }));
+  ASSERT_TRUE(ring.try_push([](int& v) { v = 2; }));
+  std::atomic<bool> stop{false};
+  int waits = 0;
+  const bool pushed = ring.push_wait([](int& v) { v = 3; }, stop, [&] {
+    if (++waits == 3) stop = true;  // the consumer never comes: a stop ends the wait
+  });
+  EXPECT_FALSE(pushed);
+  EXPECT_EQ(waits, 3);
+  EXPECT_EQ(ring.dropped(), 1u);
+  EXPECT_EQ(*ring.front(), 1);
 }
 
 TEST(SpscRing, AProducerThatNeverWaitsDropsTheNewestAndCountsEveryOne) {
@@ -82,12 +94,7 @@ TEST(SpscRing, AProducerThatNeverWaitsDropsTheNewestAndCountsEveryOne) {
   std::atomic<bool> done{false};
   std::thread producer([&] {
     for (std::uint64_t i = 0; i < kItems; ++i) {
-      if (std::uint64_t* slot = ring.try_claim()) {
-        *slot = i;
-        ring.publish();
-      } else {
-        ring.count_drop();
-      }
+      (void)ring.try_push([i](std::uint64_t& slot) { slot = i; });
     }
     done = true;
   });

@@ -6,8 +6,11 @@
 // publishes it, the consumer reads it in place and releases it, so nothing is copied twice
 // and nothing is allocated after construction.
 //
-// A full ring never blocks the producer: try_claim() returns nullptr and the caller drops
-// the newest item, counting it with count_drop() (the counter is readable from any thread).
+// The ring owns its drop policy. try_push() never blocks: on a full ring the newest item is
+// dropped and counted (dropped(), readable from any thread). push_wait() is for producers that
+// must not lose anything (an as-fast-as-possible replay): it waits for room, calling the
+// caller's `on_full` between tries (wake the consumer, sleep), until the stop flag is set,
+// when the item is dropped and counted like any other.
 //
 // Memory order: publish() stores the tail with release after the slot is written; the
 // consumer's acquire load of the tail makes the slot's contents visible; release() stores the
@@ -19,6 +22,7 @@
 #include <new>
 #include <stdexcept>
 #include <type_traits>
+#include <utility>
 
 namespace trajroi::transport {
 
@@ -42,6 +46,38 @@ class SpscRing {
   [[nodiscard]] std::size_t capacity() const noexcept { return mask_ + 1; }
 
   // ---- producer ----
+  // Fills the next free slot with fill(T&) and publishes it; false (the item dropped and
+  // counted) when the ring is full.
+  template <typename Fill>
+  [[nodiscard]] bool try_push(Fill&& fill) noexcept(noexcept(fill(std::declval<T&>()))) {
+    T* slot = try_claim();
+    if (slot == nullptr) {
+      dropped_.fetch_add(1, std::memory_order_relaxed);
+      return false;
+    }
+    fill(*slot);
+    publish();
+    return true;
+  }
+  // As try_push, but a full ring is waited on: on_full() runs between tries (it should wake
+  // the consumer and sleep briefly). False (dropped and counted) only once `stop` is set.
+  template <typename Fill, typename OnFull>
+  [[nodiscard]] bool push_wait(Fill&& fill, const std::atomic<bool>& stop, OnFull&& on_full) {
+    T* slot = try_claim();
+    while (slot == nullptr) {
+      if (stop.load(std::memory_order_relaxed)) {
+        dropped_.fetch_add(1, std::memory_order_relaxed);
+        return false;
+      }
+      on_full();
+      slot = try_claim();
+    }
+    fill(*slot);
+    publish();
+    return true;
+  }
+
+  // The primitives try_push is made of (tests use them to check the memory order).
   // The next free slot to fill, or nullptr when the ring is full.
   [[nodiscard]] T* try_claim() noexcept {
     const std::size_t tail = tail_.load(std::memory_order_relaxed);
@@ -53,8 +89,6 @@ class SpscRing {
   }
   // Makes the slot try_claim() returned visible to the consumer.
   void publish() noexcept { tail_.store(tail_.load(std::memory_order_relaxed) + 1, std::memory_order_release); }
-  // A claim that failed: the newest item is dropped.
-  void count_drop() noexcept { dropped_.fetch_add(1, std::memory_order_relaxed); }
 
   // ---- consumer ----
   // The oldest published item, or nullptr when the ring is empty.

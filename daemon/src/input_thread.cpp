@@ -1,0 +1,101 @@
+// The input thread: one source, one ring. Live and replay run this same loop; only the source
+// object differs (inputs::UdpInput, inputs::SerialInput or inputs::RecordedInput).
+#include <algorithm>
+#include <chrono>
+#include <thread>
+
+#include "log.hpp"
+#include "realtime.hpp"
+#include "threads.hpp"
+
+namespace trajroi::daemon {
+
+namespace {
+
+// Publishes the source's counters for the status (a few relaxed stores).
+void copy_counters(const inputs::InputSource& source, InputLane& lane) {
+  const inputs::InputCounters c = source.counters();
+  lane.oversize.store(c.oversize, std::memory_order_relaxed);
+  lane.errors.store(c.errors, std::memory_order_relaxed);
+  lane.disconnects.store(c.disconnects, std::memory_order_relaxed);
+  lane.rejected_sources.store(c.rejected_sources, std::memory_order_relaxed);
+  lane.kernel_drops.store(c.kernel_drops, std::memory_order_relaxed);
+}
+
+}  // namespace
+
+void input_loop(Pipeline& pipeline, InputLane& lane) {
+  if (const std::string w = apply_thread_config(lane.thread_name.c_str(), lane.thread); !w.empty()) log::warn("{}", w);
+  prefault_stack();
+  const std::int64_t cpu_start = thread_cpu_ns();
+  inputs::InputSource& source = *lane.source;
+  Ring<InputSlot>& ring = *lane.ring;
+  log::RateLimited error_limit(pipeline.config.logging.warning_interval_s);
+  // A paced replay hands items over in batches (one wake-up each); a batch is capped so a
+  // replay running behind still wakes the processing thread.
+  constexpr int kMaxBatch = 16;
+  int unnotified = 0;
+  std::uint32_t items = 0;
+  const auto on_full = [&pipeline] {
+    pipeline.process_wake.notify();
+    std::this_thread::sleep_for(std::chrono::microseconds(50));
+  };
+  inputs::InputItem item;
+  while (!pipeline.stop.load(std::memory_order_relaxed)) {
+    const auto next = source.next(item, std::chrono::milliseconds(kIdleWait_ms));
+    if (next != inputs::InputSource::Next::kItem) {
+      copy_counters(source, lane);
+      if (unnotified > 0) {
+        pipeline.process_wake.notify();
+        unnotified = 0;
+      }
+    }
+    if (next == inputs::InputSource::Next::kEnd) break;
+    if (next == inputs::InputSource::Next::kTimeout) continue;
+    if (next == inputs::InputSource::Next::kNotice) {
+      const inputs::Notice& n = source.notice();
+      if (n.level == inputs::Notice::Level::kWarning) {
+        log::warn("{}", n.text);
+      } else {
+        log::info("{}", n.text);
+      }
+      continue;
+    }
+    if (next == inputs::InputSource::Next::kError) {
+      std::uint64_t suppressed = 0;
+      if (error_limit.allow(steady_ns(), suppressed)) {
+        log::warn("{}: {}{}", source.describe(), source.error(),
+                  suppressed > 0 ? " (" + std::to_string(suppressed) + " similar suppressed)" : std::string());
+      }
+      continue;
+    }
+    // One slot per datagram; serial bytes in slot-sized pieces with the same receive time.
+    std::span<const std::uint8_t> rest = item.bytes;
+    if (inputs::is_lidar(item.stream) && rest.size() > kMaxItemBytes) continue;  // counted by the source
+    do {
+      const auto piece = rest.first(std::min(kMaxItemBytes, rest.size()));
+      rest = rest.subspan(piece.size());
+      const auto fill = [&](InputSlot& slot) {
+        slot.receive_ns = item.receive_ns;
+        slot.stream = item.stream;
+        slot.size = static_cast<std::uint16_t>(piece.size());
+        std::copy(piece.begin(), piece.end(), slot.bytes.begin());
+        slot.arrival_ns = steady_ns();
+        slot.seq = pipeline.sequence.fetch_add(1, std::memory_order_relaxed);
+      };
+      const bool pushed = pipeline.exact ? ring.push_wait(fill, pipeline.stop, on_full) : ring.try_push(fill);
+      if (!pushed) lane.ring_drops[static_cast<std::size_t>(item.stream)].fetch_add(1, std::memory_order_relaxed);
+    } while (!rest.empty());
+    if ((++items & 255U) == 0) copy_counters(source, lane);  // current under constant traffic
+    if (!source.ready() || ++unnotified >= kMaxBatch) {
+      pipeline.process_wake.notify();
+      unnotified = 0;
+    }
+  }
+  copy_counters(source, lane);
+  pipeline.cpu_sources_ns.fetch_add(thread_cpu_ns() - cpu_start);
+  lane.done.store(true, std::memory_order_release);
+  pipeline.process_wake.notify();
+}
+
+}  // namespace trajroi::daemon

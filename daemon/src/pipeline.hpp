@@ -1,0 +1,124 @@
+#pragma once
+
+// What trajroid's threads share: the rings between them, the wake-ups, the stop flag and the
+// per-input counters. One Pipeline per daemon; each thread's loop (input_thread.cpp,
+// processing.cpp, publisher.cpp, recorder.cpp, reload.cpp) takes it by reference, so a unit
+// test drives them with a fake source and a fake outlet without the binary.
+#include <poll.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+#include <array>
+#include <atomic>
+#include <cerrno>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "trajroi/daemon/config.hpp"
+#include "trajroi/daemon/sweep_processor.hpp"
+#include "trajroi/inputs/input_source.hpp"
+#include "trajroi/transport/spsc_ring.hpp"
+
+namespace trajroi::daemon {
+
+template <typename T>
+using Ring = transport::SpscRing<T>;
+
+inline constexpr std::size_t kMaxItemBytes = 1500;  // Ethernet MTU: a VLP-16 packet is 1206
+inline constexpr int kIdleWait_ms = 100;            // every loop wakes at least this often
+
+// CLOCK_MONOTONIC and the calling thread's CPU time, ns.
+[[nodiscard]] std::int64_t steady_ns() noexcept;
+[[nodiscard]] std::int64_t thread_cpu_ns() noexcept;
+
+class EventFd {
+ public:
+  EventFd() : fd_(eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) {
+    if (fd_ < 0) throw std::runtime_error(std::string("eventfd: ") + std::strerror(errno));
+  }
+  ~EventFd() { close(fd_); }
+  EventFd(const EventFd&) = delete;
+  EventFd& operator=(const EventFd&) = delete;
+  [[nodiscard]] int fd() const noexcept { return fd_; }
+  void notify() const noexcept {
+    const std::uint64_t one = 1;
+    (void)!write(fd_, &one, sizeof one);
+  }
+  void drain() const noexcept {
+    std::uint64_t value = 0;
+    (void)!read(fd_, &value, sizeof value);
+  }
+  // Waits until notified or the timeout passes.
+  void wait(int timeout_ms) const noexcept {
+    pollfd p{fd_, POLLIN, 0};
+    if (poll(&p, 1, timeout_ms) > 0) drain();
+  }
+
+ private:
+  int fd_;
+};
+
+// One input item in a ring slot (serial reads longer than a slot are split, same time).
+struct InputSlot {
+  std::uint64_t seq = 0;        // the pipeline's global order (Pipeline::sequence)
+  std::int64_t receive_ns = 0;  // CLOCK_MONOTONIC of the input (as recorded in a replay)
+  std::int64_t arrival_ns = 0;  // CLOCK_MONOTONIC when it entered the ring (latency)
+  inputs::Stream stream = inputs::Stream::kLidarData;
+  std::uint16_t size = 0;
+  std::array<std::uint8_t, kMaxItemBytes> bytes{};
+};
+
+// One input source with its reader thread's ring and what that thread counted.
+struct InputLane {
+  std::unique_ptr<inputs::InputSource> source;
+  std::unique_ptr<Ring<InputSlot>> ring;
+  std::string thread_name;  // "trajroid-lidar", …
+  ThreadConfig thread;
+  std::atomic<bool> done{false};
+  // Copied from the source's counters by the reader, for the status.
+  std::atomic<std::uint64_t> oversize{0}, errors{0}, disconnects{0}, rejected_sources{0}, kernel_drops{0};
+  std::array<std::atomic<std::uint64_t>, inputs::kStreamCount> ring_drops{};  // by stream
+};
+
+struct TrajectoryItem {
+  std::unique_ptr<ActiveTrajectory> trajectory;
+};
+
+struct StatusSnapshot;
+
+struct Pipeline {
+  // `exact`: an as-fast-as-possible replay, where a full ring is waited on (the output is
+  // the same on every run); otherwise a full ring drops the newest item and counts it.
+  Pipeline(const DaemonConfig& config, bool exact, bool record);
+  ~Pipeline();
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
+
+  // Adds a source and its ring (before the threads start).
+  InputLane& add_input(std::unique_ptr<inputs::InputSource> source, std::size_t ring_capacity, std::string thread_name,
+                       const ThreadConfig& thread);
+  [[nodiscard]] bool inputs_done() const noexcept;
+  [[nodiscard]] bool inputs_empty() const noexcept;
+
+  const DaemonConfig& config;
+  const bool exact;
+  std::atomic<bool> stop{false};
+  std::atomic<std::uint64_t> sequence{0};
+  EventFd process_wake, publish_wake, record_wake, main_wake;
+  std::vector<std::unique_ptr<InputLane>> inputs;
+  Ring<Sweep> sweeps;
+  std::unique_ptr<Ring<StatusSnapshot>> status;
+  Ring<TrajectoryItem> trajectories_in;   // publisher → processing
+  Ring<TrajectoryItem> trajectories_out;  // processing → publisher (to free)
+  std::unique_ptr<Ring<InputSlot>> record;  // processing → recorder, when recording
+  std::atomic<bool> processing_done{false}, publishing_done{false};
+  std::atomic<std::uint64_t> processing_beat{0}, publishing_beat{0};
+  // CPU time of each kind of thread, added as each ends (for the summary).
+  std::atomic<std::int64_t> cpu_sources_ns{0}, cpu_processing_ns{0}, cpu_publishing_ns{0};
+};
+
+}  // namespace trajroi::daemon

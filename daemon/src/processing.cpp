@@ -1,0 +1,178 @@
+// The processing thread: every lane's items in their global order through the SweepProcessor;
+// finished sweeps to the publisher's ring; a status snapshot once a second and at the end.
+#include <chrono>
+#include <limits>
+#include <thread>
+
+#include "log.hpp"
+#include "realtime.hpp"
+#include "status.hpp"
+#include "threads.hpp"
+
+namespace trajroi::daemon {
+
+namespace {
+
+constexpr std::int64_t kSecond_ns = 1'000'000'000;
+
+// Hands each finished sweep to the publisher's ring (copied into a preallocated slot) with
+// the processing time it took.
+class RingSink final : public SweepSink {
+ public:
+  explicit RingSink(Pipeline& pipeline) : pipeline_(pipeline) {}
+  void on_sweep(const Sweep& sweep) override {
+    const std::int64_t now = steady_ns();
+    const auto fill = [&](Sweep& slot) {
+      slot = sweep;  // vector assignment within the reserved capacity: no allocation
+      slot.processing_ns = accumulated_ns_ + (now - packet_start_ns_);
+    };
+    const auto on_full = [this] {
+      pipeline_.publish_wake.notify();
+      std::this_thread::sleep_for(std::chrono::microseconds(20));
+    };
+    // An as-fast-as-possible replay waits for the publisher (exact output); live drops.
+    const bool pushed = pipeline_.exact ? pipeline_.sweeps.push_wait(fill, pipeline_.stop, on_full)
+                                        : pipeline_.sweeps.try_push(fill);
+    if (pushed) pipeline_.publish_wake.notify();
+    accumulated_ns_ = 0;
+    packet_start_ns_ = now;
+  }
+  void packet_started(std::int64_t now) noexcept { packet_start_ns_ = now; }
+  void packet_done(std::int64_t now) noexcept { accumulated_ns_ += now - packet_start_ns_; }
+
+ private:
+  Pipeline& pipeline_;
+  std::int64_t accumulated_ns_ = 0;
+  std::int64_t packet_start_ns_ = 0;
+};
+
+class Processing {
+ public:
+  Processing(Pipeline& pipeline, SweepProcessor& processor) : pipeline_(pipeline), processor_(processor), sink_(pipeline) {}
+
+  // The lane whose front item (`front`) is oldest in the global order, or null when all are empty.
+  InputLane* oldest(InputSlot*& front) noexcept {
+    InputLane* best = nullptr;
+    std::uint64_t best_seq = ~std::uint64_t{0};
+    for (const auto& lane : pipeline_.inputs) {
+      InputSlot* slot = lane->ring->front();
+      if (slot != nullptr && slot->seq < best_seq) {
+        best_seq = slot->seq;
+        best = lane.get();
+        front = slot;
+      }
+    }
+    return best;
+  }
+
+  void handle(InputLane& lane, InputSlot& item) {
+    const std::span<const std::uint8_t> bytes(item.bytes.data(), item.size);
+    switch (item.stream) {
+      case inputs::Stream::kLidarData:
+      case inputs::Stream::kLidarPosition: {
+        const std::int64_t start = steady_ns();
+        sink_.packet_started(start);
+        processor_.set_input_arrival(item.arrival_ns);
+        last_lidar_receive_ns_ = item.receive_ns;
+        processor_.lidar_datagram(item.stream == inputs::Stream::kLidarData ? LidarPort::kData : LidarPort::kPosition,
+                                  bytes, item.receive_ns, sink_);
+        sink_.packet_done(steady_ns());
+        break;
+      }
+      case inputs::Stream::kGnss: processor_.gnss_bytes(bytes, item.receive_ns); break;
+      case inputs::Stream::kImu: processor_.imu_bytes(bytes, item.receive_ns); break;
+    }
+    if (pipeline_.record) {
+      const auto on_full = [this] {
+        pipeline_.record_wake.notify();
+        std::this_thread::sleep_for(std::chrono::microseconds(20));
+      };
+      const auto copy = [&item](InputSlot& slot) { slot = item; };
+      (void)(pipeline_.exact ? pipeline_.record->push_wait(copy, pipeline_.stop, on_full)
+                             : pipeline_.record->try_push(copy));
+    }
+    lane.ring->release();
+  }
+
+  // Trajectories offered by the publisher come in; retired ones go back to be freed there.
+  void exchange_trajectories() {
+    while (TrajectoryItem* t = pipeline_.trajectories_in.front()) {
+      processor_.offer_trajectory(std::move(t->trajectory));
+      pipeline_.trajectories_in.release();
+    }
+    if (auto retired = processor_.take_retired()) {
+      // A full ring (the publisher has not collected 8 of them) frees it here, once.
+      (void)pipeline_.trajectories_out.try_push([&retired](TrajectoryItem& slot) { slot.trajectory = std::move(retired); });
+    }
+  }
+
+  void snapshot(bool final) {
+    const bool pushed = pipeline_.status->try_push(
+        [&](StatusSnapshot& s) { fill_snapshot(processor_, pipeline_, last_lidar_receive_ns_, final, s); });
+    if (pushed) pipeline_.publish_wake.notify();
+  }
+
+  void run(const ProcessingOptions& options) {
+    std::int64_t next_status = steady_ns() + kSecond_ns;
+    const std::int64_t stall_at = options.stall_after_s
+                                      ? steady_ns() + static_cast<std::int64_t>(*options.stall_after_s * 1e9)
+                                      : std::numeric_limits<std::int64_t>::max();
+    for (;;) {
+      if (steady_ns() >= stall_at) {
+        log::warn("fault injection: the processing thread stops making progress");
+        while (!pipeline_.stop.load(std::memory_order_relaxed)) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        break;
+      }
+      pipeline_.processing_beat.fetch_add(1, std::memory_order_relaxed);
+      exchange_trajectories();
+      // The items waiting, oldest first, at most a batch before the checks above.
+      int handled = 0;
+      for (; handled < 256; ++handled) {
+        InputSlot* front = nullptr;
+        InputLane* lane = oldest(front);
+        if (lane == nullptr || front == nullptr) break;
+        handle(*lane, *front);
+      }
+      if (handled > 0 && pipeline_.record) pipeline_.record_wake.notify();
+
+      const std::int64_t now = steady_ns();
+      if (now >= next_status) {
+        snapshot(false);
+        next_status += kSecond_ns;
+        if (next_status < now) next_status = now + kSecond_ns;
+      }
+      // Stopping (SIGTERM) or at the end of a replay: what was received is processed, and the
+      // sweep in progress goes out (partial): nothing already received is lost.
+      const bool stopping = pipeline_.stop.load(std::memory_order_relaxed);
+      if (handled == 0 && (stopping || (pipeline_.inputs_done() && pipeline_.inputs_empty()))) {
+        processor_.flush(sink_);
+        break;
+      }
+      if (handled == 0) pipeline_.process_wake.wait(kIdleWait_ms);
+    }
+    snapshot(true);
+  }
+
+ private:
+  Pipeline& pipeline_;
+  SweepProcessor& processor_;
+  RingSink sink_;
+  std::int64_t last_lidar_receive_ns_ = 0;
+};
+
+}  // namespace
+
+void processing_loop(Pipeline& pipeline, SweepProcessor& processor, const ProcessingOptions& options) {
+  if (const std::string w = apply_thread_config("trajroid-proc", pipeline.config.realtime.processing); !w.empty()) {
+    log::warn("{}", w);
+  }
+  prefault_stack();
+  const std::int64_t cpu_start = thread_cpu_ns();
+  Processing(pipeline, processor).run(options);
+  pipeline.cpu_processing_ns.fetch_add(thread_cpu_ns() - cpu_start);
+  pipeline.processing_done.store(true, std::memory_order_release);
+  pipeline.publish_wake.notify();
+  pipeline.record_wake.notify();
+}
+
+}  // namespace trajroi::daemon

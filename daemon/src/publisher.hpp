@@ -1,0 +1,63 @@
+#pragma once
+
+// The publisher thread: sweeps and status snapshots from the processing thread out through the
+// Outlet (LCM: points, pose, roi, status), trajectory messages in (checked, then offered to the
+// processing thread), SIGHUP reloads offered likewise, latency percentiles per status window
+// and per minute, and the run's summary figures.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "log.hpp"
+#include "outlet.hpp"
+#include "pipeline.hpp"
+#include "reload.hpp"
+#include "status.hpp"
+#include "trajroi/daemon/latency_histogram.hpp"
+#include "trajroi/daemon/messages.hpp"
+#include "trajroi/pose/geodetic.hpp"
+
+namespace trajroi::daemon {
+
+class Publisher {
+ public:
+  // `replay`: said in the status message. `reloader` may be null (no SIGHUP reloads).
+  Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, bool replay);
+  void run();
+
+  // After run(): the last status and the whole run's latency, for the summary.
+  [[nodiscard]] const StatusSnapshot& last_status() const noexcept { return last_status_; }
+  [[nodiscard]] const LatencyHistogram& latency() const noexcept { return latency_all_; }
+
+ private:
+  void on_trajectory_message(std::span<const std::uint8_t> bytes, const std::string& channel);
+  void offer(std::unique_ptr<ActiveTrajectory> trajectory);
+  void publish_sweep(const Sweep& s);
+  void publish_status(const StatusSnapshot& s);
+  void log_minute(const StatusSnapshot& s);
+  void take_reloads();
+  void warn_rate_limited(const std::string& message);
+  template <typename Message>
+  void send(const std::string& channel, const Message& m);
+
+  Pipeline& pipeline_;
+  Outlet& outlet_;
+  Reloader* reloader_;
+  bool replay_;
+  const DaemonConfig& config_;
+  pose::GlobalFrame frame_;
+  std::vector<std::uint8_t> encoded_;
+  trajroi::points_t points_;
+  trajroi::pose_t pose_;
+  trajroi::roi_t roi_;
+  std::array<std::uint64_t, kTrajectoryRejectCount> trajectory_rejects_{};
+  std::uint64_t trajectories_accepted_ = 0, trajectory_reloads_ = 0, trajectory_reload_errors_ = 0;
+  std::vector<double> latency_window_ms_, processing_window_ms_, latency_minute_ms_;
+  LatencyHistogram latency_all_;
+  StatusSnapshot minute_start_;  // the status at the start of the current minute
+  StatusSnapshot last_status_;
+  std::int64_t start_steady_ns_;
+  log::RateLimited warn_limit_;
+};
+
+}  // namespace trajroi::daemon

@@ -1,0 +1,51 @@
+// The recorder: every item the processing thread handled, written as a run folder (lidar.pcap,
+// gnss.trjb, imu.trjb) that replays to the same output.
+#include "log.hpp"
+#include "threads.hpp"
+#include "trajroi/inputs/run_merger.hpp"
+#include "trajroi/serial/byte_log.hpp"
+#include "trajroi/vlp16/pcap_source.hpp"
+
+namespace trajroi::daemon {
+
+namespace {
+
+void record_to(Pipeline& pipeline, const std::filesystem::path& dir) {
+  vlp16::PcapWriter pcap(dir / inputs::kLidarFile);
+  serial::RecordingWriter gnss((dir / inputs::kGnssFile).string());
+  serial::RecordingWriter imu((dir / inputs::kImuFile).string());
+  Ring<InputSlot>& ring = *pipeline.record;
+  for (;;) {
+    bool any = false;
+    while (InputSlot* s = ring.front()) {
+      const std::span<const std::uint8_t> bytes(s->bytes.data(), s->size);
+      switch (s->stream) {
+        case inputs::Stream::kLidarData: pcap.write(s->receive_ns, vlp16::kDataPort, bytes); break;
+        case inputs::Stream::kLidarPosition: pcap.write(s->receive_ns, vlp16::kPositionPort, bytes); break;
+        case inputs::Stream::kGnss: gnss.write(serial::Chunk{bytes, s->receive_ns}); break;
+        case inputs::Stream::kImu: imu.write(serial::Chunk{bytes, s->receive_ns}); break;
+      }
+      ring.release();
+      any = true;
+    }
+    if (!any && pipeline.processing_done.load(std::memory_order_acquire) && ring.front() == nullptr) break;
+    if (!any) pipeline.record_wake.wait(kIdleWait_ms);
+  }
+  pcap.close();
+  gnss.flush();
+  imu.flush();
+}
+
+}  // namespace
+
+void recorder_loop(Pipeline& pipeline, const std::filesystem::path& dir) {
+  pthread_setname_np(pthread_self(), "trajroid-rec");
+  try {
+    record_to(pipeline, dir);
+  } catch (const std::exception& e) {
+    // The pipeline goes on; what cannot be recorded fills the record ring, counted.
+    log::error("--record stopped: {}", e.what());
+  }
+}
+
+}  // namespace trajroi::daemon

@@ -1,0 +1,162 @@
+#include "status.hpp"
+
+#include <string>
+
+#include "pipeline.hpp"
+
+namespace trajroi::daemon {
+namespace {
+
+using C = Counter;
+
+constexpr std::size_t at(Counter c) { return static_cast<std::size_t>(c); }
+
+// Names, built once: the decoders' enums give the names of their blocks.
+struct Names {
+  std::array<std::string, kCounterCount> name;
+  Names() {
+    const auto set = [this](Counter c, const char* n) { name[at(c)] = n; };
+    set(C::kRingDropsLidar, "ring_drops.lidar");
+    set(C::kRingDropsGnss, "ring_drops.gnss");
+    set(C::kRingDropsImu, "ring_drops.imu");
+    set(C::kRingDropsSweeps, "ring_drops.sweeps");
+    set(C::kRingDropsStatus, "ring_drops.status");
+    set(C::kRingDropsTrajectory, "ring_drops.trajectory");
+    set(C::kRingDropsRecord, "ring_drops.record");
+    set(C::kLidarOversize, "lidar.oversize_datagrams");
+    set(C::kLidarSourceErrors, "lidar.source_errors");
+    set(C::kLidarRejectedSource, "lidar.rejected_source");
+    set(C::kLidarKernelDrops, "lidar.kernel_drops");
+    for (std::size_t e = 1; e < vlp16::kPacketErrorCount; ++e) {
+      name[at(C::kLidarRejected) + e - 1] = "lidar.rejected." + std::string(vlp16::to_string(static_cast<vlp16::PacketError>(e)));
+    }
+    set(C::kLidarOutOfOrder, "lidar.out_of_order");
+    set(C::kLidarRestarts, "lidar.restarts");
+    set(C::kLidarLateDropped, "lidar.late_dropped");
+    set(C::kLidarDuplicates, "lidar.duplicates");
+    set(C::kLidarClockResets, "lidar.clock_resets");
+    set(C::kLidarNoReturn, "lidar.no_return");
+    set(C::kLidarOutOfRange, "lidar.out_of_range");
+    set(C::kLidarPartialSweeps, "lidar.partial_sweeps");
+    set(C::kLidarPositionWrongSize, "lidar.position_wrong_size");
+    for (std::size_t e = 1; e < vlp16::kNmeaErrorCount; ++e) {
+      name[at(C::kLidarNmea) + e - 1] = "lidar.nmea." + std::string(vlp16::to_string(static_cast<vlp16::NmeaError>(e)));
+    }
+    set(C::kGnssBytes, "gnss.bytes");
+    set(C::kGnssFrames, "gnss.frames");
+    set(C::kGnssSkippedBytes, "gnss.skipped_bytes");
+    set(C::kGnssChecksumErrors, "gnss.checksum_errors");
+    set(C::kGnssBadLengths, "gnss.bad_lengths");
+    set(C::kImuBytes, "imu.bytes");
+    set(C::kImuFrames, "imu.frames");
+    set(C::kImuSkippedBytes, "imu.skipped_bytes");
+    set(C::kImuChecksumErrors, "imu.checksum_errors");
+    set(C::kImuBadLengths, "imu.bad_lengths");
+    set(C::kSerialDisconnects, "serial.disconnects");
+    set(C::kPoseFixes, "pose.fixes");
+    set(C::kPoseHighPrecisionFixes, "pose.high_precision_fixes");
+    set(C::kPoseInvalidPosition, "pose.invalid_position");
+    set(C::kPoseMalformedMessages, "pose.malformed_messages");
+    set(C::kPoseAttitudes, "pose.attitudes");
+    set(C::kPoseImuWithoutAttitude, "pose.imu_without_attitude");
+    set(C::kPoseRefusedSamples, "pose.refused_samples");
+    set(C::kPoseGnssClockResets, "pose.gnss_clock_resets");
+    set(C::kPoseImuClockResets, "pose.imu_clock_resets");
+    set(C::kSweepsPointsTruncated, "sweeps.points_truncated");
+    set(C::kTrajectorySwaps, "trajectory.swaps");
+    set(C::kTrajectoryProjectionReacquired, "trajectory.projection_reacquired");
+  }
+};
+
+const Names& names() {
+  static const Names n;
+  return n;
+}
+
+}  // namespace
+
+std::string_view counter_name(std::size_t index) noexcept {
+  return index < kCounterCount ? std::string_view(names().name[index]) : std::string_view("?");
+}
+
+std::uint64_t StatusSnapshot::ring_drops() const noexcept {
+  std::uint64_t drops = 0;
+  for (std::size_t c = at(C::kRingDropsLidar); c <= at(C::kRingDropsRecord); ++c) drops += counters[c];
+  return drops;
+}
+
+void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64_t last_lidar_receive_ns, bool final,
+                   StatusSnapshot& s) {
+  (void)names();  // built before the first status, off the hot path
+  const vlp16::StreamCounters& l = p.lidar_counters();
+  s.steady_ns = steady_ns();
+  s.final = final;
+  s.trajectory_id = p.active_trajectory_id();
+  s.processor = p.counters();
+  s.lidar_packets = l.data_packets;
+  s.position_packets = l.position_packets;
+  s.lost_packets = l.lost_packets;
+  s.decode_errors = l.rejected_total();
+  const Sweep& current = p.current();
+  s.pose_valid = current.pose_status == pose::PoseStatus::kValid;
+  s.pose_status = current.pose_status;
+  const pose::GnssFix* fix = p.poses().newest_fix();
+  s.pose_age_s = fix != nullptr ? static_cast<double>(last_lidar_receive_ns - fix->t_ns) * 1e-9 : -1.0;
+  s.fix_type = fix != nullptr ? fix->quality.fix_type : 0;
+  s.h_acc_m = fix != nullptr ? fix->quality.h_acc_m : 0.0;
+
+  s.counters.fill(0);
+  for (const auto& lane : pipeline.inputs) {
+    const auto drops = [&lane](inputs::Stream st) {
+      return lane->ring_drops[static_cast<std::size_t>(st)].load(std::memory_order_relaxed);
+    };
+    s[C::kRingDropsLidar] += drops(inputs::Stream::kLidarData) + drops(inputs::Stream::kLidarPosition);
+    s[C::kRingDropsGnss] += drops(inputs::Stream::kGnss);
+    s[C::kRingDropsImu] += drops(inputs::Stream::kImu);
+    s[C::kLidarOversize] += lane->oversize.load(std::memory_order_relaxed);
+    s[C::kLidarRejectedSource] += lane->rejected_sources.load(std::memory_order_relaxed);
+    s[C::kLidarKernelDrops] += lane->kernel_drops.load(std::memory_order_relaxed);
+    s[C::kSerialDisconnects] += lane->disconnects.load(std::memory_order_relaxed);
+    s[C::kLidarSourceErrors] += lane->errors.load(std::memory_order_relaxed);
+  }
+  s[C::kRingDropsSweeps] = pipeline.sweeps.dropped();
+  s[C::kRingDropsStatus] = pipeline.status->dropped();
+  s[C::kRingDropsTrajectory] = pipeline.trajectories_in.dropped();
+  s[C::kRingDropsRecord] = pipeline.record ? pipeline.record->dropped() : 0;
+  for (std::size_t e = 1; e < vlp16::kPacketErrorCount; ++e) s.counters[at(C::kLidarRejected) + e - 1] = l.rejected[e];
+  s[C::kLidarOutOfOrder] = l.out_of_order;
+  s[C::kLidarRestarts] = l.restarts;
+  s[C::kLidarLateDropped] = l.late_dropped;
+  s[C::kLidarDuplicates] = l.duplicates;
+  s[C::kLidarClockResets] = l.clock_resets;
+  s[C::kLidarNoReturn] = l.no_return;
+  s[C::kLidarOutOfRange] = l.out_of_range;
+  s[C::kLidarPartialSweeps] = l.partial_frames;
+  s[C::kLidarPositionWrongSize] = l.position_wrong_size;
+  for (std::size_t e = 1; e < vlp16::kNmeaErrorCount; ++e) s.counters[at(C::kLidarNmea) + e - 1] = l.nmea[e];
+  const pose_input::PoseInput& in = p.pose_input();
+  const auto framing = [&s](Counter first, const framing::FramerCounters& f) {
+    s.counters[at(first)] = f.bytes;
+    s.counters[at(first) + 1] = f.frames;
+    s.counters[at(first) + 2] = f.skipped_bytes;
+    s.counters[at(first) + 3] = f.checksum_errors;
+    s.counters[at(first) + 4] = f.bad_lengths + f.unsizable;
+  };
+  framing(C::kGnssBytes, in.gnss_framing());
+  framing(C::kImuBytes, in.imu_framing());
+  const pose_input::PoseInputCounters& pc = in.counters();
+  s[C::kPoseFixes] = pc.fixes;
+  s[C::kPoseHighPrecisionFixes] = pc.high_precision;
+  s[C::kPoseInvalidPosition] = pc.invalid_position;
+  s[C::kPoseMalformedMessages] = pc.malformed;
+  s[C::kPoseAttitudes] = pc.attitudes;
+  s[C::kPoseImuWithoutAttitude] = pc.imu_without_attitude;
+  s[C::kPoseRefusedSamples] = pc.refused;
+  s[C::kPoseGnssClockResets] = in.gnss_clock().resets();
+  s[C::kPoseImuClockResets] = in.imu_clock().resets();
+  s[C::kSweepsPointsTruncated] = p.counters().points_truncated;
+  s[C::kTrajectorySwaps] = p.counters().trajectory_swaps;
+  s[C::kTrajectoryProjectionReacquired] = p.counters().projection_reacquired;
+}
+
+}  // namespace trajroi::daemon

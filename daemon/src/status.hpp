@@ -1,0 +1,66 @@
+#pragma once
+
+// The status table: every counter trajroid reports, in one enum-indexed array with prefixed
+// names ("ring_drops.lidar", "lidar.rejected.wrong_size", "pose.fixes", …). The processing
+// thread fills a snapshot once a second (and a final one) for the publisher's status message.
+#include <array>
+#include <cstdint>
+#include <string_view>
+
+#include "trajroi/pose/pose_buffer.hpp"
+#include "trajroi/vlp16/position.hpp"
+#include "trajroi/vlp16/packet.hpp"
+#include "trajroi/daemon/sweep_processor.hpp"
+
+namespace trajroi::daemon {
+
+struct Pipeline;
+
+// Ranges of the decoders' own error enums sit in the table as blocks (their kNone omitted).
+enum class Counter : std::uint16_t {
+  kRingDropsLidar, kRingDropsGnss, kRingDropsImu, kRingDropsSweeps, kRingDropsStatus, kRingDropsTrajectory,
+  kRingDropsRecord,
+  kLidarOversize, kLidarSourceErrors, kLidarRejectedSource, kLidarKernelDrops,
+  kLidarRejected,  // + PacketError − 1
+  kLidarOutOfOrder = kLidarRejected + vlp16::kPacketErrorCount - 1,
+  kLidarRestarts, kLidarLateDropped, kLidarDuplicates, kLidarClockResets, kLidarNoReturn, kLidarOutOfRange,
+  kLidarPartialSweeps, kLidarPositionWrongSize,
+  kLidarNmea,  // + NmeaError − 1
+  kGnssBytes = kLidarNmea + vlp16::kNmeaErrorCount - 1,
+  kGnssFrames, kGnssSkippedBytes, kGnssChecksumErrors, kGnssBadLengths,
+  kImuBytes, kImuFrames, kImuSkippedBytes, kImuChecksumErrors, kImuBadLengths,
+  kSerialDisconnects,
+  kPoseFixes, kPoseHighPrecisionFixes, kPoseInvalidPosition, kPoseMalformedMessages, kPoseAttitudes,
+  kPoseImuWithoutAttitude, kPoseRefusedSamples, kPoseGnssClockResets, kPoseImuClockResets,
+  kSweepsPointsTruncated, kTrajectorySwaps, kTrajectoryProjectionReacquired,
+  kCount
+};
+inline constexpr std::size_t kCounterCount = static_cast<std::size_t>(Counter::kCount);
+
+// The counter's name in the status message.
+[[nodiscard]] std::string_view counter_name(std::size_t index) noexcept;
+
+struct StatusSnapshot {
+  std::int64_t steady_ns = 0;
+  std::int32_t trajectory_id = 0;
+  ProcessorCounters processor;
+  std::uint64_t lidar_packets = 0, position_packets = 0, lost_packets = 0, decode_errors = 0;
+  bool pose_valid = false;
+  pose::PoseStatus pose_status = pose::PoseStatus::kNoGnss;
+  double pose_age_s = -1.0;
+  std::uint8_t fix_type = 0;
+  double h_acc_m = 0.0;
+  bool final = false;  // the last one: the input has ended
+  std::array<std::uint64_t, kCounterCount> counters{};
+
+  [[nodiscard]] std::uint64_t& operator[](Counter c) noexcept { return counters[static_cast<std::size_t>(c)]; }
+  [[nodiscard]] std::uint64_t operator[](Counter c) const noexcept { return counters[static_cast<std::size_t>(c)]; }
+  // Every ring's drops together.
+  [[nodiscard]] std::uint64_t ring_drops() const noexcept;
+};
+
+// Fills `s` from the processor (processing thread) and the pipeline's rings and inputs.
+void fill_snapshot(const SweepProcessor& processor, const Pipeline& pipeline, std::int64_t last_lidar_receive_ns,
+                   bool final, StatusSnapshot& s);
+
+}  // namespace trajroi::daemon

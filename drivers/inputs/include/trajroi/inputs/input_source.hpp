@@ -1,0 +1,75 @@
+#pragma once
+
+// What every input of trajroid is: a stream of items {stream, bytes, receive time}, the time
+// always the host's CLOCK_MONOTONIC in ns (a live source converts at the edge; a recorded
+// source hands back what was recorded). The daemon's input thread, `trajroi feed` and the
+// evaluations read through this interface and cannot tell a live sensor from a recording
+// except by the end of the latter.
+#include <chrono>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace trajroi::inputs {
+
+enum class Stream : std::uint8_t {
+  kLidarData,      // a VLP-16 data packet (UDP 2368)
+  kLidarPosition,  // a VLP-16 position packet (UDP 8308)
+  kGnss,           // bytes from the GNSS receiver (u-blox UBX)
+  kImu,            // bytes from the IMU (VN-100 binary)
+};
+inline constexpr std::size_t kStreamCount = 4;
+[[nodiscard]] std::string_view to_string(Stream stream) noexcept;
+[[nodiscard]] constexpr bool is_lidar(Stream s) noexcept { return s == Stream::kLidarData || s == Stream::kLidarPosition; }
+
+struct InputItem {
+  Stream stream = Stream::kLidarData;
+  std::span<const std::uint8_t> bytes;  // valid until the next call to next()
+  std::int64_t receive_ns = 0;          // CLOCK_MONOTONIC (or as recorded)
+};
+
+// Something the source wants said in the log (a port opened, a device unplugged, a lap).
+struct Notice {
+  enum class Level : std::uint8_t { kInfo, kWarning } level = Level::kInfo;
+  std::string text;
+};
+
+// Counted by the source, read by its one reader thread (copied to the status from there).
+struct InputCounters {
+  std::uint64_t items = 0;
+  std::uint64_t oversize = 0;          // datagrams too long for a Velodyne packet (dropped)
+  std::uint64_t errors = 0;            // socket or file errors
+  std::uint64_t disconnects = 0;       // serial devices that went away
+  std::uint64_t rejected_sources = 0;  // datagrams from an address other than the sensor's
+  std::uint64_t kernel_drops = 0;      // datagrams the kernel dropped (full receive buffer)
+};
+
+class InputSource {
+ public:
+  enum class Next : std::uint8_t {
+    kItem,     // `item` is filled
+    kTimeout,  // nothing within the timeout; call again
+    kNotice,   // notice() has something to log; call again
+    kError,    // error() says what failed; the source goes on (live) or ends (a cut file)
+    kEnd,      // a recording's end: nothing more will come
+  };
+  virtual ~InputSource() = default;
+  // Waits at most `timeout` for the next item. Never throws once constructed.
+  virtual Next next(InputItem& item, std::chrono::milliseconds timeout) = 0;
+  // True when next() would return an item now without waiting (a paced recording's next item
+  // is due): the reader hands items over in batches and wakes its consumer once per batch. A
+  // live source says false: each datagram wakes the consumer.
+  [[nodiscard]] virtual bool ready() const noexcept { return false; }
+  [[nodiscard]] virtual const Notice& notice() const noexcept = 0;
+  [[nodiscard]] virtual const std::string& error() const noexcept = 0;
+  [[nodiscard]] virtual InputCounters counters() const noexcept = 0;
+  // What is read, for logs ("UDP 0.0.0.0:2368/8308", "/dev/gnss at 115200 baud", a folder).
+  [[nodiscard]] virtual std::string describe() const = 0;
+};
+
+// The host clocks, in ns.
+[[nodiscard]] std::int64_t monotonic_ns() noexcept;
+[[nodiscard]] std::int64_t realtime_ns() noexcept;
+
+}  // namespace trajroi::inputs

@@ -1,0 +1,78 @@
+#pragma once
+
+// The one merger: a run folder's recordings — lidar.pcap (data and position packets),
+// gnss.trjb and imu.trjb — read as one stream of items in recorded receive-time order (ties:
+// GNSS, then IMU, then LiDAR, so a pose sample recorded with a packet is known before it).
+// The same order on every run: what makes a replay exact.
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "trajroi/inputs/input_source.hpp"
+
+namespace trajroi::vlp16 {
+class PcapSource;
+}
+namespace trajroi::serial {
+class ReplaySource;
+}
+
+namespace trajroi::inputs {
+
+inline constexpr const char* kLidarFile = "lidar.pcap";
+inline constexpr const char* kGnssFile = "gnss.trjb";
+inline constexpr const char* kImuFile = "imu.trjb";
+
+struct RunStreams {
+  bool lidar = true, gnss = true, imu = true;
+};
+
+class RunMerger {
+ public:
+  // Opens the folder's recordings (the streams asked for). A missing gnss.trjb or imu.trjb
+  // leaves that stream silent (missing() names it); a missing or unreadable lidar.pcap
+  // throws std::runtime_error naming it. `shift_ns` is added to every recorded time.
+  RunMerger(const std::filesystem::path& dir, RunStreams streams = {}, std::int64_t shift_ns = 0);
+  ~RunMerger();
+  RunMerger(const RunMerger&) = delete;
+  RunMerger& operator=(const RunMerger&) = delete;
+
+  // The next item in receive-time order; false at the end of every recording. `item.bytes`
+  // stays valid until the next call.
+  bool next(InputItem& item);
+  // The receive time of the item next() returns next, or false at the end.
+  [[nodiscard]] bool peek_time(std::int64_t& receive_ns) noexcept;
+
+  [[nodiscard]] const std::vector<std::string>& missing() const noexcept { return missing_; }
+  // A recording cut or unreadable mid-way ends that stream; this says why (empty: none).
+  [[nodiscard]] const std::string& error() const noexcept { return error_; }
+  [[nodiscard]] std::uint64_t oversize() const noexcept { return oversize_; }
+  // First and last recorded times handed out so far (after the shift).
+  [[nodiscard]] std::int64_t first_ns() const noexcept { return first_ns_; }
+  [[nodiscard]] std::int64_t last_ns() const noexcept { return last_ns_; }
+
+ private:
+  struct Pending {
+    bool have = false;
+    std::int64_t t = 0;
+    Stream stream = Stream::kLidarData;
+    std::vector<std::uint8_t> bytes;
+  };
+  void fill_lidar();
+  void fill_serial(serial::ReplaySource* source, Pending& p, Stream stream);
+  [[nodiscard]] Pending* earliest() noexcept;
+
+  std::unique_ptr<vlp16::PcapSource> pcap_;
+  std::unique_ptr<serial::ReplaySource> gnss_, imu_;
+  std::int64_t shift_ns_;
+  Pending lidar_, gnss_next_, imu_next_;
+  std::vector<std::uint8_t> out_;  // the item handed out
+  std::vector<std::string> missing_;
+  std::string error_;
+  std::uint64_t oversize_ = 0;
+  std::int64_t first_ns_ = INT64_MAX, last_ns_ = INT64_MIN;
+};
+
+}  // namespace trajroi::inputs

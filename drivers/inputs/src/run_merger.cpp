@@ -1,0 +1,106 @@
+#include "trajroi/inputs/run_merger.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "trajroi/serial/byte_log.hpp"
+#include "trajroi/vlp16/pcap_source.hpp"
+
+namespace trajroi::inputs {
+
+namespace fs = std::filesystem;
+
+namespace {
+constexpr std::size_t kMaxDatagram = 1500;  // Ethernet MTU: a VLP-16 packet is 1206
+}
+
+RunMerger::RunMerger(const fs::path& dir, RunStreams streams, std::int64_t shift_ns) : shift_ns_(shift_ns) {
+  if (streams.lidar) {
+    vlp16::PcapOptions options;
+    options.ports = {vlp16::kDataPort, vlp16::kPositionPort};
+    pcap_ = std::make_unique<vlp16::PcapSource>(dir / kLidarFile, options);
+  }
+  const auto open_serial = [&](bool wanted, const char* name) -> std::unique_ptr<serial::ReplaySource> {
+    if (!wanted) return nullptr;
+    if (!fs::exists(dir / name)) {
+      missing_.push_back((dir / name).string());
+      return nullptr;
+    }
+    return std::make_unique<serial::ReplaySource>((dir / name).string());
+  };
+  gnss_ = open_serial(streams.gnss, kGnssFile);
+  imu_ = open_serial(streams.imu, kImuFile);
+  fill_lidar();
+  fill_serial(gnss_.get(), gnss_next_, Stream::kGnss);
+  fill_serial(imu_.get(), imu_next_, Stream::kImu);
+}
+
+RunMerger::~RunMerger() = default;
+
+void RunMerger::fill_lidar() {
+  lidar_.have = false;
+  if (!pcap_) return;
+  vlp16::Datagram d;
+  for (;;) {
+    const auto r = pcap_->next(d);
+    if (r != vlp16::PacketSource::Next::kDatagram) {
+      if (r == vlp16::PacketSource::Next::kError) error_ = pcap_->error();
+      return;
+    }
+    if (d.payload.size() > kMaxDatagram) {
+      ++oversize_;
+      continue;
+    }
+    lidar_.have = true;
+    lidar_.t = d.receive_time_ns + shift_ns_;
+    lidar_.stream = d.destination_port == vlp16::kPositionPort ? Stream::kLidarPosition : Stream::kLidarData;
+    lidar_.bytes.assign(d.payload.begin(), d.payload.end());
+    return;
+  }
+}
+
+void RunMerger::fill_serial(serial::ReplaySource* source, Pending& p, Stream stream) {
+  serial::Chunk chunk;
+  p.have = source != nullptr && source->read(chunk, std::chrono::milliseconds(0)) == serial::ReadStatus::kData;
+  if (p.have) {
+    p.t = chunk.receive_time_ns + shift_ns_;
+    p.stream = stream;
+    p.bytes.assign(chunk.bytes.begin(), chunk.bytes.end());
+  }
+}
+
+RunMerger::Pending* RunMerger::earliest() noexcept {
+  Pending* p = nullptr;
+  for (Pending* c : {&gnss_next_, &imu_next_, &lidar_}) {
+    if (c->have && (p == nullptr || c->t < p->t)) p = c;
+  }
+  return p;
+}
+
+bool RunMerger::peek_time(std::int64_t& receive_ns) noexcept {
+  const Pending* p = earliest();
+  if (p == nullptr) return false;
+  receive_ns = p->t;
+  return true;
+}
+
+bool RunMerger::next(InputItem& item) {
+  Pending* p = earliest();
+  if (p == nullptr) return false;
+  out_.swap(p->bytes);
+  item.stream = p->stream;
+  item.receive_ns = p->t;
+  item.bytes = out_;
+  first_ns_ = std::min(first_ns_, p->t);
+  last_ns_ = std::max(last_ns_, p->t);
+  if (p == &lidar_) {
+    fill_lidar();
+  } else if (p == &gnss_next_) {
+    fill_serial(gnss_.get(), gnss_next_, Stream::kGnss);
+  } else {
+    fill_serial(imu_.get(), imu_next_, Stream::kImu);
+  }
+  return true;
+}
+
+}  // namespace trajroi::inputs
