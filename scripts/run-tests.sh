@@ -25,6 +25,6 @@ if [ "${TRAJROI_SKIP_SANITIZERS:-0}" != "1" ]; then
   cmake --preset tsan
   cmake --build --preset tsan -j"$jobs" --target transport_tests daemon_tests
   # One at a time: two ThreadSanitizer daemons at real-time pace on 2 cores fall behind.
-  ctest --preset tsan -j1 -R '^(SpscRing|TrajroidEndToEnd|TrajroidControl)\.'
+  ctest --preset tsan -j1 -R '^(SpscRing|Pipeline|TrajroidEndToEnd|TrajroidControl)\.'
   bash scripts/fuzz.sh "${TRAJROI_FUZZ_SECONDS:-60}"
 fi

@@ -1,5 +1,7 @@
 #include "trajroi/daemon/config.hpp"
 
+#include "trajroi/config/text_file.hpp"
+
 #include <arpa/inet.h>
 
 #include <cmath>
@@ -235,11 +237,7 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
 }
 
 DaemonConfig load_daemon_config(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw ConfigError(file.string() + ": cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_daemon_config(text.str(), file);
+  return parse_daemon_config(config::read_text_file(file), file);
 }
 
 }  // namespace trajroi::daemon

@@ -1,5 +1,7 @@
 #include "trajroi/daemon/sweep_processor.hpp"
 
+#include "trajroi/config/text_file.hpp"
+
 #include <array>
 #include <algorithm>
 #include <fstream>
@@ -24,11 +26,7 @@ constexpr double kReacquireDistance_m = 5.0;
 
 vlp16::Calibration load_calibration(const std::filesystem::path& file) {
   if (file.empty()) return vlp16::Calibration::vlp16_default();
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw std::runtime_error(file.string() + ": cannot read the lidar calibration");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return vlp16::parse_calibration_yaml(text.str(), file.string());
+  return vlp16::parse_calibration_yaml(config::read_text_file(file), file.string());
 }
 
 vlp16::StreamOptions stream_options(const DaemonConfig& c) {

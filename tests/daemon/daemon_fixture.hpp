@@ -28,6 +28,7 @@
 #include "trajroi/status_t.hpp"
 #include "trajroi/transport/lcm_subscribe.hpp"
 #include "trajroi/trajectory_t.hpp"
+#include "trajroi/inputs/capture.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
 #include "trajroi/vlp16/stream_decoder.hpp"
 
@@ -83,15 +84,7 @@ inline std::vector<trajroi::vlp16::Frame> decode_capture(const fs::path& pcap) {
   options.decode.max_range_m = 60.0;
   trajroi::vlp16::StreamDecoder decoder(trajroi::vlp16::Calibration::vlp16_default(), options);
   trajroi::vlp16::PcapSource source(pcap);
-  trajroi::vlp16::Datagram d;
-  while (source.next(d) == trajroi::vlp16::PacketSource::Next::kDatagram) {
-    if (d.destination_port == trajroi::vlp16::kDataPort) {
-      decoder.on_data_packet(d.payload, d.receive_time_ns, sink);
-    } else {
-      decoder.on_position_packet(d.payload);
-    }
-  }
-  decoder.flush(sink);
+  trajroi::inputs::CaptureDecoder(source, decoder).run(sink);
   return std::move(sink.frames);
 }
 

@@ -11,8 +11,7 @@
 #include "trajroi/daemon/config.hpp"
 #include "trajroi/daemon/sweep_processor.hpp"
 #include "trajroi/roi/trajectory.hpp"
-#include "trajroi/serial/byte_log.hpp"
-#include "trajroi/vlp16/pcap_source.hpp"
+#include "trajroi/inputs/run_merger.hpp"
 
 namespace {
 
@@ -30,29 +29,20 @@ struct Event {
   std::vector<std::uint8_t> bytes;
 };
 
-// Every input of the run, in receive-time order (GNSS before IMU before lidar on a tie, as
-// trajroid's replay).
+// Every input of the run, in receive-time order (the daemon's own merger).
 const std::vector<Event>& run_events() {
   static const std::vector<Event> events = [] {
     std::vector<Event> out;
-    trajroi::vlp16::PcapSource pcap(corridor_run() / "lidar.pcap");
-    trajroi::vlp16::Datagram d;
-    while (pcap.next(d) == trajroi::vlp16::PacketSource::Next::kDatagram) {
-      out.push_back({Event::kLidar,
-                     d.destination_port == trajroi::vlp16::kPositionPort ? LidarPort::kPosition : LidarPort::kData,
-                     d.receive_time_ns, std::vector<std::uint8_t>(d.payload.begin(), d.payload.end())});
+    trajroi::inputs::RunMerger merger(corridor_run());
+    trajroi::inputs::InputItem item;
+    while (merger.next(item)) {
+      using trajroi::inputs::Stream;
+      const Event::Kind kind = item.stream == Stream::kGnss  ? Event::kGnss
+                               : item.stream == Stream::kImu ? Event::kImu
+                                                             : Event::kLidar;
+      out.push_back({kind, item.stream == Stream::kLidarPosition ? LidarPort::kPosition : LidarPort::kData,
+                     item.receive_ns, std::vector<std::uint8_t>(item.bytes.begin(), item.bytes.end())});
     }
-    for (const auto& [kind, name] : {std::pair{Event::kGnss, "gnss.trjb"}, std::pair{Event::kImu, "imu.trjb"}}) {
-      trajroi::serial::ReplaySource source((corridor_run() / name).string());
-      trajroi::serial::Chunk chunk;
-      while (source.read(chunk, std::chrono::milliseconds(0)) == trajroi::serial::ReadStatus::kData) {
-        out.push_back({kind, LidarPort::kData, chunk.receive_time_ns,
-                       std::vector<std::uint8_t>(chunk.bytes.begin(), chunk.bytes.end())});
-      }
-    }
-    std::stable_sort(out.begin(), out.end(), [](const Event& a, const Event& b) {
-      return a.t_ns != b.t_ns ? a.t_ns < b.t_ns : static_cast<int>(a.kind) > static_cast<int>(b.kind);
-    });
     return out;
   }();
   return events;

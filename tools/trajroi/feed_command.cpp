@@ -26,26 +26,14 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "trajroi/serial/byte_log.hpp"
-#include "trajroi/sim/run_folder.hpp"
-#include "trajroi/vlp16/pcap_source.hpp"
+#include "trajroi/inputs/pacer.hpp"
+#include "trajroi/inputs/run_merger.hpp"
+#include "trajroi/vlp16/packet_source.hpp"
 
 namespace trajroi::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::int64_t monotonic_ns() {
-  timespec t{};
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return static_cast<std::int64_t>(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
-}
-
-void sleep_until(std::int64_t deadline_ns) {
-  const timespec t{static_cast<time_t>(deadline_ns / 1'000'000'000), static_cast<long>(deadline_ns % 1'000'000'000)};
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &t, nullptr) == EINTR) {
-  }
-}
 
 // "gnss@6+2": the stream's device vanishes 6 s into the data and comes back 2 s later.
 struct Hangup {
@@ -141,7 +129,7 @@ class PtyDevice {
     std::error_code ignored;
     fs::remove(link_, ignored);
     fs::create_symlink(slave, link_);
-    appeared_ns_ = monotonic_ns();
+    appeared_ns_ = inputs::monotonic_ns();
     reopen_reported_ = false;
     std::printf("feed: %s device %s -> %s\n", name_.c_str(), link_.c_str(), slave);
     std::fflush(stdout);
@@ -158,7 +146,7 @@ class PtyDevice {
     if (reopen_reported_ || generation == 0 || !reader_open()) return;
     reopen_reported_ = true;
     std::printf("feed: %s reopened by the reader %.3f s after it reappeared\n", name_.c_str(),
-                static_cast<double>(monotonic_ns() - appeared_ns_) * 1e-9);
+                static_cast<double>(inputs::monotonic_ns() - appeared_ns_) * 1e-9);
     std::fflush(stdout);
   }
 
@@ -222,29 +210,19 @@ std::vector<std::uint8_t> malformed(std::span<const std::uint8_t> real, std::uin
   return out;
 }
 
-struct Stream {
-  std::optional<std::int64_t> t;  // recorded receive time of `bytes`
-  std::vector<std::uint8_t> bytes;
-  std::uint16_t port = 0;
-};
-
 void run_feed(const FeedOptions& o) {
   if (!(o.rate > 0.0)) throw std::invalid_argument("--rate must be > 0");
   if (o.foreign_every == 0) throw std::invalid_argument("--foreign-every must be >= 1");
   const fs::path dir = o.run_dir;
-  vlp16::PcapOptions pcap_options;
-  pcap_options.ports = {vlp16::kDataPort, vlp16::kPositionPort};
-  vlp16::PcapSource pcap(dir / sim::kLidarFile, pcap_options);
-  std::unique_ptr<serial::ReplaySource> gnss_log, imu_log;
+  // The run's recordings in receive-time order (the daemon's own merger), paced by the pacer.
+  inputs::RunStreams streams;
+  streams.gnss = !o.gnss_link.empty();
+  streams.imu = !o.imu_link.empty();
+  inputs::RunMerger merger(dir, streams);
+  for (const std::string& missing : merger.missing()) throw std::runtime_error(missing + ": not found");
   std::unique_ptr<PtyDevice> gnss_dev, imu_dev;
-  if (!o.gnss_link.empty()) {
-    gnss_log = std::make_unique<serial::ReplaySource>((dir / sim::kGnssFile).string());
-    gnss_dev = std::make_unique<PtyDevice>("gnss", o.gnss_link);
-  }
-  if (!o.imu_link.empty()) {
-    imu_log = std::make_unique<serial::ReplaySource>((dir / sim::kImuFile).string());
-    imu_dev = std::make_unique<PtyDevice>("imu", o.imu_link);
-  }
+  if (streams.gnss) gnss_dev = std::make_unique<PtyDevice>("gnss", o.gnss_link);
+  if (streams.imu) imu_dev = std::make_unique<PtyDevice>("imu", o.imu_link);
   std::vector<Hangup> hangups;
   for (const std::string& h : o.hangups) hangups.push_back(parse_hangup(h));
   UdpSender sensor(o.from);
@@ -252,41 +230,18 @@ void run_feed(const FeedOptions& o) {
   if (!o.foreign_from.empty()) foreign = std::make_unique<UdpSender>(o.foreign_from);
 
   // The readers open their devices first (a daemon starting), then the clock starts.
-  const std::int64_t give_up = monotonic_ns() + static_cast<std::int64_t>(o.wait_for_readers_s * 1e9);
+  const std::int64_t give_up = inputs::monotonic_ns() + static_cast<std::int64_t>(o.wait_for_readers_s * 1e9);
   while ((gnss_dev && !gnss_dev->reader_open()) || (imu_dev && !imu_dev->reader_open())) {
-    if (monotonic_ns() > give_up) throw std::runtime_error("no reader opened the serial devices within --wait-for-readers");
-    sleep_until(monotonic_ns() + 10'000'000);
+    if (inputs::monotonic_ns() > give_up) {
+      throw std::runtime_error("no reader opened the serial devices within --wait-for-readers");
+    }
+    inputs::Pacer::sleep_until(inputs::monotonic_ns() + 10'000'000);
   }
 
-  Stream lidar, gnss, imu;
-  vlp16::Datagram d;
-  const auto next_lidar = [&] {
-    lidar.t.reset();
-    if (pcap.next(d) == vlp16::PacketSource::Next::kDatagram) {
-      lidar.t = d.receive_time_ns;
-      lidar.bytes.assign(d.payload.begin(), d.payload.end());
-      lidar.port = d.destination_port == vlp16::kPositionPort ? o.position_port : o.data_port;
-    }
-  };
-  const auto next_serial = [](serial::ReplaySource* log, Stream& s) {
-    s.t.reset();
-    serial::Chunk chunk;
-    if (log != nullptr && log->read(chunk, std::chrono::milliseconds(0)) == serial::ReadStatus::kData) {
-      s.t = chunk.receive_time_ns;
-      s.bytes.assign(chunk.bytes.begin(), chunk.bytes.end());
-    }
-  };
-  next_lidar();
-  next_serial(gnss_log.get(), gnss);
-  next_serial(imu_log.get(), imu);
-  std::int64_t t0 = INT64_MAX;
-  for (const Stream* s : {&lidar, &gnss, &imu}) {
-    if (s->t) t0 = std::min(t0, *s->t);
-  }
-  if (t0 == INT64_MAX) throw std::runtime_error(dir.string() + ": nothing to feed");
-  // Recorded times are host monotonic (serial) and CLOCK_REALTIME (pcap) of the recording
-  // machine; both count from their first item here, which is what the daemon records too.
-  const std::int64_t start = monotonic_ns();
+  std::int64_t t0 = 0;
+  if (!merger.peek_time(t0)) throw std::runtime_error(dir.string() + ": nothing to feed");
+  inputs::Pacer pacer(o.rate);
+  const std::int64_t start = inputs::monotonic_ns();
   double data_s = 0.0;
   std::uint64_t flood_sent = 0, malformed_sent = 0, foreign_sent = 0, data_sent = 0;
   std::uint64_t serial_undelivered[2] = {0, 0};
@@ -296,14 +251,10 @@ void run_feed(const FeedOptions& o) {
   const double flood_extra = std::max(0.0, o.flood_factor - 1.0);
   double flood_credit = 0.0;
 
-  for (;;) {
-    Stream* next = nullptr;
-    for (Stream* s : {&lidar, &gnss, &imu}) {
-      if (s->t && (next == nullptr || *s->t < *next->t)) next = s;
-    }
-    if (next == nullptr) break;
-    data_s = static_cast<double>(*next->t - t0) * 1e-9;
-    sleep_until(start + static_cast<std::int64_t>(static_cast<double>(*next->t - t0) / o.rate));
+  inputs::InputItem item;
+  while (merger.next(item)) {
+    data_s = static_cast<double>(item.receive_ns - t0) * 1e-9;
+    inputs::Pacer::sleep_until(pacer.due_ns(item.receive_ns));
 
     for (std::size_t i = 0; i < hangups.size(); ++i) {  // devices coming back
       PtyDevice* dev = hangups[i].stream == "gnss" ? gnss_dev.get() : imu_dev.get();
@@ -316,58 +267,57 @@ void run_feed(const FeedOptions& o) {
     if (gnss_dev) gnss_dev->report_reopen(generation[0]);
     if (imu_dev) imu_dev->report_reopen(generation[1]);
 
-    if (next == &lidar) {
-      sensor.send(lidar.bytes, lidar.port);
-      if (lidar.port == o.data_port) {
+    if (inputs::is_lidar(item.stream)) {
+      const bool data = item.stream == inputs::Stream::kLidarData;
+      sensor.send(item.bytes, data ? o.data_port : o.position_port);
+      if (data) {
         ++data_sent;
         if (foreign && data_sent % o.foreign_every == 0) {
-          foreign->send(lidar.bytes, lidar.port);
+          foreign->send(item.bytes, o.data_port);
           ++foreign_sent;
         }
         if (o.flood_at_s >= 0.0 && data_s >= o.flood_at_s && data_s < o.flood_at_s + o.flood_for_s) {
           flood_credit += flood_extra;
           for (; flood_credit >= 1.0; flood_credit -= 1.0) {
             if (std::uniform_real_distribution<double>(0.0, 1.0)(random) < o.malformed_fraction) {
-              sensor.send(malformed(lidar.bytes, malformed_sent++, random), o.data_port);
+              sensor.send(malformed(item.bytes, malformed_sent++, random), o.data_port);
             } else {
-              sensor.send(lidar.bytes, o.data_port);  // a copy: a duplicate to the decoder
+              sensor.send(item.bytes, o.data_port);  // a copy: a duplicate to the decoder
             }
             ++flood_sent;
           }
         }
       }
-      next_lidar();
       continue;
     }
-    const int k = next == &gnss ? 0 : 1;
+    const int k = item.stream == inputs::Stream::kGnss ? 0 : 1;
     PtyDevice& dev = k == 0 ? *gnss_dev : *imu_dev;
     bool wrote = false;
     for (std::size_t i = 0; i < hangups.size(); ++i) {
       if (!hung[i] && hangups[i].stream == (k == 0 ? "gnss" : "imu") && data_s >= hangups[i].at_s) {
         // Unplugged in the middle of this chunk: half of it goes out, then the device is gone.
         hung[i] = true;
-        const std::size_t half = next->bytes.size() / 2;
-        dev.write(std::span<const std::uint8_t>(next->bytes.data(), half));
+        const std::size_t half = item.bytes.size() / 2;
+        dev.write(item.bytes.first(half));
         dev.vanish();
         std::printf("feed: %s device vanished at %.3f s of data, %zu bytes into a %zu-byte chunk\n",
-                    k == 0 ? "gnss" : "imu", data_s, half, next->bytes.size());
+                    k == 0 ? "gnss" : "imu", data_s, half, item.bytes.size());
         std::fflush(stdout);
         wrote = true;
       }
     }
-    if (!wrote && !dev.write(next->bytes)) ++serial_undelivered[k];
-    next_serial(k == 0 ? gnss_log.get() : imu_log.get(), *next);
+    if (!wrote && !dev.write(item.bytes)) ++serial_undelivered[k];
   }
   std::printf("feed: done: %.3f s of data in %.3f s; UDP sent %llu (%llu data, %llu flood of which %llu malformed)"
               " from %s, %llu from %s; serial chunks with no reader: gnss %llu, imu %llu\n",
               data_s,
-              static_cast<double>(monotonic_ns() - start) * 1e-9, static_cast<unsigned long long>(sensor.sent()),
+              static_cast<double>(inputs::monotonic_ns() - start) * 1e-9, static_cast<unsigned long long>(sensor.sent()),
               static_cast<unsigned long long>(data_sent), static_cast<unsigned long long>(flood_sent),
               static_cast<unsigned long long>(malformed_sent), o.from.c_str(),
               static_cast<unsigned long long>(foreign_sent), o.foreign_from.empty() ? "-" : o.foreign_from.c_str(),
               static_cast<unsigned long long>(serial_undelivered[0]), static_cast<unsigned long long>(serial_undelivered[1]));
   std::fflush(stdout);
-  sleep_until(monotonic_ns() + static_cast<std::int64_t>(o.linger_s * 1e9));
+  inputs::Pacer::sleep_until(inputs::monotonic_ns() + static_cast<std::int64_t>(o.linger_s * 1e9));
 }
 
 }  // namespace

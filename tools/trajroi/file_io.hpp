@@ -4,10 +4,12 @@
 #include <string>
 #include <string_view>
 
+#include "trajroi/config/text_file.hpp"
+
 namespace trajroi::cli {
 
-// The whole file as text; throws std::runtime_error naming the path when it cannot be read.
-[[nodiscard]] std::string read_text_file(const std::filesystem::path& path);
+// The whole file as text (the project's one reader); throws naming the path when it cannot be read.
+using config::read_text_file;
 
 // Writes `content` to a temporary file beside `path` and renames it over `path`, so readers
 // never see a half-written file and a failure leaves any previous file untouched.

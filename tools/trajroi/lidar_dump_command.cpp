@@ -17,6 +17,7 @@
 #include "commands.hpp"
 #include "file_io.hpp"
 #include "trajroi/framing/utc.hpp"
+#include "trajroi/inputs/capture.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
 #include "trajroi/vlp16/stream_decoder.hpp"
 
@@ -132,17 +133,14 @@ void run_lidar_dump(const LidarDumpOptions& o) {
   FrameSink& sink = csv ? static_cast<FrameSink&>(*csv) : null_sink;
 
   std::map<std::uint8_t, std::uint64_t> product_ids;  // byte 1205 of every 1206-byte payload
-  Datagram datagram;
+  inputs::CaptureDecoder capture(source, decoder, o.data_port, o.position_port);
   PacketSource::Next next;
-  while ((next = source.next(datagram)) == PacketSource::Next::kDatagram) {
-    if (datagram.destination_port == o.position_port) {
-      decoder.on_position_packet(datagram.payload);
-      continue;
+  while ((next = capture.step(sink)) == PacketSource::Next::kDatagram) {
+    const Datagram& datagram = capture.last();
+    if (datagram.destination_port == o.data_port && datagram.payload.size() == kDataPacketBytes) {
+      ++product_ids[product_id(datagram.payload)];
     }
-    if (datagram.payload.size() == kDataPacketBytes) ++product_ids[product_id(datagram.payload)];
-    decoder.on_data_packet(datagram.payload, datagram.receive_time_ns, sink);
   }
-  decoder.flush(sink);
   if (csv) csv->commit();
   const std::string read_error = next == PacketSource::Next::kError ? source.error() : "";
 

@@ -22,6 +22,7 @@
 #include "trajroi/sim/run_folder.hpp"
 #include "trajroi/status_t.hpp"
 #include "trajroi/transport/lcm_subscribe.hpp"
+#include "trajroi/inputs/capture.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
 #include "trajroi/vlp16/stream_decoder.hpp"
 
@@ -91,16 +92,8 @@ class TruthScorer {
     } keep;
     keep.frames = &frames_;
     while (!frames_.empty() && frames_.front().index < index) frames_.pop_front();
-    vlp16::Datagram d;
     while ((frames_.empty() || frames_.back().index < index) && !ended_) {
-      if (source_.next(d) != vlp16::PacketSource::Next::kDatagram) {
-        decoder_.flush(keep);
-        ended_ = true;
-      } else if (d.destination_port == vlp16::kDataPort) {
-        decoder_.on_data_packet(d.payload, d.receive_time_ns, keep);
-      } else {
-        decoder_.on_position_packet(d.payload);
-      }
+      ended_ = capture_.step(keep) != vlp16::PacketSource::Next::kDatagram;
     }
     for (const auto& f : frames_) {
       if (f.index == index) return &f;
@@ -111,6 +104,7 @@ class TruthScorer {
   eval::ScenarioRun run_;
   vlp16::PcapSource source_;
   vlp16::StreamDecoder decoder_;
+  inputs::CaptureDecoder capture_{source_, decoder_};
   std::deque<vlp16::Frame> frames_;
   bool ended_ = false;
   std::vector<roi::PointXYZd> truth_points_;

@@ -3,31 +3,23 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <numbers>
-#include <sstream>
 #include <stdexcept>
 
 #include "trajroi/config/yaml_reader.hpp"
 #include "trajroi/roi/grid_filter.hpp"
 #include "trajroi/roi/shapes.hpp"
 #include "trajroi/roi/transform.hpp"
-#include "trajroi/serial/byte_log.hpp"
+#include "trajroi/config/text_file.hpp"
+#include "trajroi/inputs/capture.hpp"
+#include "trajroi/inputs/run_merger.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
 
 namespace trajroi::eval {
 namespace fs = std::filesystem;
 namespace {
 
-
-std::string read_file_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path.string() + ": cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return std::move(text).str();
-}
 
 template <typename Point>
 void push_point(std::vector<Point>& out, const Eigen::Vector3d& p, float intensity) {
@@ -78,7 +70,7 @@ ScenarioRun::ScenarioRun(const fs::path& dir) : dir_(dir) {
   sim::require_run_folder(dir);
   scenario_ = sim::load_scenario(dir / sim::kScenarioFile);
   trajectory_ = std::make_unique<roi::Trajectory>(
-      roi::parse_trajectory_csv(read_file_text(dir / sim::kTrajectoryFile), (dir / sim::kTrajectoryFile).string()));
+      roi::parse_trajectory_csv(config::read_text_file(dir / sim::kTrajectoryFile), (dir / sim::kTrajectoryFile).string()));
   robot_from_lidar_ = scenario_.robot.lidar.robot_from_sensor();
 
   // The pose, from the recorded streams through the drivers and the pose library. The gate
@@ -91,20 +83,15 @@ ScenarioRun::ScenarioRun(const fs::path& dir) : dir_(dir) {
   config.gnss_delay_ns = std::llround(sim::gnss_delay_s(scenario_.gnss) * 1e9);
   config.imu_delay_ns = std::llround(sim::imu_delay_s(scenario_.imu) * 1e9);
   pose_input::PoseInput input(pose::GlobalFrame::local_cartesian(scenario_.origin), config, *poses_);
-  // The two recordings in receive-time order, as a live daemon gets them (an attitude is
-  // turned into the global frame at the latest GNSS position).
-  serial::ReplaySource gnss((dir / sim::kGnssFile).string());
-  serial::ReplaySource imu((dir / sim::kImuFile).string());
-  serial::Chunk g, i;
-  bool have_g = gnss.read(g, std::chrono::milliseconds(0)) == serial::ReadStatus::kData;
-  bool have_i = imu.read(i, std::chrono::milliseconds(0)) == serial::ReadStatus::kData;
-  while (have_g || have_i) {
-    if (have_g && (!have_i || g.receive_time_ns <= i.receive_time_ns)) {
-      input.gnss_bytes(g.bytes, g.receive_time_ns);
-      have_g = gnss.read(g, std::chrono::milliseconds(0)) == serial::ReadStatus::kData;
+  // The two recordings in receive-time order (the daemon's merger), as a live daemon gets
+  // them (an attitude is turned into the global frame at the latest GNSS position).
+  inputs::RunMerger merger(dir, inputs::RunStreams{false, true, true});
+  inputs::InputItem item;
+  while (merger.next(item)) {
+    if (item.stream == inputs::Stream::kGnss) {
+      input.gnss_bytes(item.bytes, item.receive_ns);
     } else {
-      input.imu_bytes(i.bytes, i.receive_time_ns);
-      have_i = imu.read(i, std::chrono::milliseconds(0)) == serial::ReadStatus::kData;
+      input.imu_bytes(item.bytes, item.receive_ns);
     }
   }
   pose_counters_ = input.counters();
@@ -128,22 +115,16 @@ vlp16::StreamCounters ScenarioRun::for_each_frame(const FrameCallback& on_frame)
   sink.callback = &on_frame;
   vlp16::StreamDecoder decoder(vlp16::Calibration::vlp16_default(), {});
   vlp16::PcapSource source(dir_ / sim::kLidarFile);
-  vlp16::Datagram datagram;
-  while (true) {
-    const auto next = source.next(datagram);
+  inputs::CaptureDecoder capture(source, decoder);
+  for (;;) {
+    const auto start = std::chrono::steady_clock::now();
+    const auto next = capture.step(sink);
     if (next == vlp16::PacketSource::Next::kEnd) break;
     if (next != vlp16::PacketSource::Next::kDatagram) {
       throw std::runtime_error((dir_ / sim::kLidarFile).string() + ": " + source.error());
     }
-    if (datagram.destination_port == vlp16::kPositionPort) {
-      decoder.on_position_packet(datagram.payload);
-      continue;
-    }
-    const auto start = std::chrono::steady_clock::now();
-    decoder.on_data_packet(datagram.payload, datagram.receive_time_ns, sink);
     sink.decode_ms += elapsed_ms(start);
   }
-  decoder.flush(sink);
   return decoder.counters();
 }
 

@@ -7,6 +7,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "trajroi/config/text_file.hpp"
 #include "trajroi/config/yaml_reader.hpp"
 #include "trajroi/framing/utc.hpp"
 #include "trajroi/roi/transform.hpp"
@@ -273,11 +274,7 @@ Scenario parse_scenario(std::string_view yaml_text, const std::string& source) {
 }
 
 Scenario load_scenario(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw config::ConfigError(path.string() + ": cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_scenario(text.str(), path.string());
+  return parse_scenario(config::read_text_file(path), path.string());
 }
 
 }  // namespace trajroi::sim

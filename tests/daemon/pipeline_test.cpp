@@ -1,0 +1,198 @@
+// trajroid's thread loops driven in process: a fake input source per stream (the run's items
+// as the daemon's merger orders them) and a fake outlet that keeps every published message.
+// No binary, no sockets, no LCM: the input threads, the processing thread and the publisher
+// run as in the daemon (run by the README's test command under ThreadSanitizer too).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <vector>
+
+#include "daemon_fixture.hpp"
+#include "outlet.hpp"
+#include "pipeline.hpp"
+#include "reload.hpp"
+#include "trajroi/daemon/config.hpp"
+#include "trajroi/daemon/sweep_processor.hpp"
+#include "trajroi/inputs/pacer.hpp"
+#include "trajroi/inputs/run_merger.hpp"
+#include "trajroi/points_t.hpp"
+#include "trajroi/status_t.hpp"
+#include "trajroid.hpp"
+
+namespace {
+
+using namespace daemon_test;
+using trajroi::daemon::DaemonConfig;
+using trajroi::daemon::Pipeline;
+using trajroi::daemon::SweepProcessor;
+namespace inputs = trajroi::inputs;
+
+struct Item {
+  inputs::Stream stream;
+  std::int64_t t_ns;
+  std::vector<std::uint8_t> bytes;
+};
+
+std::vector<Item> run_items(inputs::RunStreams streams) {
+  std::vector<Item> out;
+  inputs::RunMerger merger(corridor_run(), streams);
+  inputs::InputItem item;
+  while (merger.next(item)) out.push_back({item.stream, item.receive_ns, {item.bytes.begin(), item.bytes.end()}});
+  return out;
+}
+
+// Hands out its items, then ends; says a notice and an error first (both must be logged and
+// passed over, never stop the lane).
+class FakeInput final : public inputs::InputSource {
+ public:
+  // `rate` > 0 paces the items by their times (as sensors would), 0: as fast as possible.
+  explicit FakeInput(std::vector<Item> items, double rate = 0.0) : items_(std::move(items)), pacer_(rate) {}
+  Next next(inputs::InputItem& item, std::chrono::milliseconds) override {
+    if (step_ == 0) {
+      ++step_;
+      return Next::kNotice;
+    }
+    if (step_ == 1) {
+      ++step_;
+      ++counters_.errors;
+      return Next::kError;
+    }
+    if (next_ == items_.size()) return Next::kEnd;
+    const Item& i = items_[next_++];
+    inputs::Pacer::sleep_until(pacer_.due_ns(i.t_ns));
+    item.stream = i.stream;
+    item.receive_ns = i.t_ns;
+    item.bytes = i.bytes;
+    ++counters_.items;
+    return Next::kItem;
+  }
+  [[nodiscard]] bool ready() const noexcept override { return next_ < items_.size(); }
+  [[nodiscard]] const inputs::Notice& notice() const noexcept override { return notice_; }
+  [[nodiscard]] const std::string& error() const noexcept override { return error_; }
+  [[nodiscard]] inputs::InputCounters counters() const noexcept override { return counters_; }
+  [[nodiscard]] std::string describe() const override { return "fake input"; }
+
+ private:
+  std::vector<Item> items_;
+  inputs::Pacer pacer_;
+  std::size_t next_ = 0;
+  int step_ = 0;
+  inputs::Notice notice_{inputs::Notice::Level::kInfo, "fake input: a notice"};
+  std::string error_ = "a fake error";
+  inputs::InputCounters counters_;
+};
+
+class FakeOutlet final : public trajroi::daemon::Outlet {
+ public:
+  void publish(const std::string& channel, std::span<const std::uint8_t> bytes) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    messages_[channel].emplace_back(bytes.begin(), bytes.end());
+  }
+  void subscribe(const std::string&, Handler) override {}
+  [[nodiscard]] int incoming_fd() const noexcept override { return -1; }
+  void handle_incoming() override {}
+  std::vector<std::vector<std::uint8_t>> messages(const std::string& channel) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return messages_[channel];
+  }
+
+ private:
+  std::mutex mutex_;
+  std::map<std::string, std::vector<std::vector<std::uint8_t>>> messages_;
+};
+
+template <typename Message>
+Message decode(const std::vector<std::uint8_t>& bytes) {
+  Message m;
+  EXPECT_GE(m.decode(bytes.data(), 0, static_cast<int>(bytes.size())), 0);
+  return m;
+}
+
+// The sweeps SweepProcessor makes from the run by itself, in the daemon's order.
+std::map<std::int64_t, std::size_t> reference_kept(const DaemonConfig& config) {
+  struct Count final : trajroi::daemon::SweepSink {
+    std::map<std::int64_t, std::size_t> kept;
+    void on_sweep(const trajroi::daemon::Sweep& s) override {
+      if (s.filtered) kept[static_cast<std::int64_t>(s.index)] = s.size();
+    }
+  } sink;
+  SweepProcessor processor(config, trajroi::daemon::load_trajectory(config.trajectory_file));
+  for (const Item& i : run_items({})) {
+    switch (i.stream) {
+      case inputs::Stream::kGnss: processor.gnss_bytes(i.bytes, i.t_ns); break;
+      case inputs::Stream::kImu: processor.imu_bytes(i.bytes, i.t_ns); break;
+      default:
+        processor.lidar_datagram(i.stream == inputs::Stream::kLidarData ? trajroi::daemon::LidarPort::kData
+                                                                        : trajroi::daemon::LidarPort::kPosition,
+                                 i.bytes, i.t_ns, sink);
+    }
+  }
+  processor.flush(sink);
+  return sink.kept;
+}
+
+TEST(Pipeline, ThreeFakeInputLanesThroughTheThreadsGiveTheProcessorsOwnSweeps) {
+  const DaemonConfig config = trajroi::daemon::load_daemon_config(corridor_run() / "trajroid.yaml");
+  // As live: one lane per stream (the lidar, the GNSS and the IMU source each with its thread).
+  // exact: a full ring waits (an as-fast-as-possible replay), so nothing may be dropped.
+  Pipeline pipeline(config, /*exact=*/true, /*record=*/false);
+  // Paced at 10x real time, as three sensors would deliver (each lane its own pacer).
+  constexpr double kRate = 10.0;
+  pipeline.add_input(std::make_unique<FakeInput>(run_items({true, false, false}), kRate), 64, "test-lidar", {});
+  pipeline.add_input(std::make_unique<FakeInput>(run_items({false, true, false}), kRate), 64, "test-gnss", {});
+  pipeline.add_input(std::make_unique<FakeInput>(run_items({false, false, true}), kRate), 64, "test-imu", {});
+  SweepProcessor processor(config, trajroi::daemon::load_trajectory(config.trajectory_file));
+  FakeOutlet outlet;
+  trajroi::daemon::RunOptions options;
+  options.replay = corridor_run();  // said in the status message only
+  EXPECT_EQ(trajroi::daemon::run_pipeline(pipeline, processor, outlet, options, /*signals=*/false), 0);
+
+  // Three lanes interleave by their own pace, so the pose may see an item a little later than
+  // the merged order would give it: the sweeps and their sizes are compared, not their bytes.
+  const auto reference = reference_kept(config);
+  ASSERT_GT(reference.size(), 100u);
+  std::map<std::int64_t, std::size_t> published;
+  for (const auto& bytes : outlet.messages(config.lcm.points)) {
+    const auto m = decode<trajroi::points_t>(bytes);
+    published[m.sweep_index] = static_cast<std::size_t>(m.num_points);
+  }
+  // A pose sample that reaches the processor a packet later than in the merged order moves a
+  // few points across the ROI's edge: sweeps within 1 % of the reference's kept count.
+  std::size_t close = 0;
+  for (const auto& [index, kept] : reference) {
+    const auto it = published.find(index);
+    if (it != published.end()) {
+      const double d = static_cast<double>(it->second) - static_cast<double>(kept);
+      close += std::abs(d) <= 0.01 * static_cast<double>(kept) ? 1U : 0U;
+    }
+  }
+  EXPECT_GE(static_cast<double>(close), 0.95 * static_cast<double>(reference.size()));
+  EXPECT_GE(static_cast<double>(published.size()), 0.98 * static_cast<double>(reference.size()));
+
+  const auto statuses = outlet.messages(config.lcm.status);
+  ASSERT_FALSE(statuses.empty());
+  const auto last = decode<trajroi::status_t>(statuses.back());
+  EXPECT_TRUE(last.final_status);
+  EXPECT_EQ(last.ring_drops, 0);
+  EXPECT_EQ(counter(last, "lidar.source_errors"), 3) << "one error said by each fake lane";
+  EXPECT_EQ(last.sweeps_published, static_cast<std::int64_t>(published.size()));
+}
+
+TEST(Pipeline, OneRecordedLaneIsExactlyTheProcessorsOutput) {
+  const DaemonConfig config = trajroi::daemon::load_daemon_config(corridor_run() / "trajroid.yaml");
+  Pipeline pipeline(config, /*exact=*/true, /*record=*/false);
+  pipeline.add_input(std::make_unique<FakeInput>(run_items({})), 16, "test-replay", {});
+  SweepProcessor processor(config, trajroi::daemon::load_trajectory(config.trajectory_file));
+  FakeOutlet outlet;
+  EXPECT_EQ(trajroi::daemon::run_pipeline(pipeline, processor, outlet, {}, /*signals=*/false), 0);
+  std::map<std::int64_t, std::size_t> published;
+  for (const auto& bytes : outlet.messages(config.lcm.points)) {
+    const auto m = decode<trajroi::points_t>(bytes);
+    published[m.sweep_index] = static_cast<std::size_t>(m.num_points);
+  }
+  EXPECT_EQ(published, reference_kept(config));
+}
+
+}  // namespace
