@@ -1,5 +1,6 @@
 #include "trajroi/daemon/config.hpp"
 
+#include "trajroi/config/origin.hpp"
 #include "trajroi/config/text_file.hpp"
 
 #include <arpa/inet.h>
@@ -97,13 +98,8 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
 
   {
     MapReader g = r.map("global_frame");
-    MapReader o = g.map("origin");
-    c.origin.lat_deg = o.number("lat_deg");
-    o.require(std::abs(c.origin.lat_deg) <= 90.0, "lat_deg", "must be in [-90, 90]");
-    c.origin.lon_deg = o.number("lon_deg");
-    o.require(std::abs(c.origin.lon_deg) <= 180.0, "lon_deg", "must be in [-180, 180]");
-    c.origin.height_m = o.number("height_m", 0.0);
-    o.finish();
+    const config::Origin o = config::read_origin(g.map("origin"));
+    c.origin = pose::Geodetic{o.lat_deg, o.lon_deg, o.height_m};
     g.finish();
   }
   {

@@ -73,7 +73,10 @@ struct DaemonRun {
 };
 
 DaemonRun trajroid(const fs::path& config, const std::string& extra = "") {
-  const fs::path err = config.string() + ".err";
+  // stderr goes to the temporary folder, never beside the configuration (the example's is in
+  // the source tree).
+  const fs::path err = fs::temp_directory_path() / ("trajroid_config_" + std::to_string(::getpid()) + "_" +
+                                                    config.filename().string() + ".err");
   const int code = daemon_test::run_command(std::string(TRAJROID) + " --config " + config.string() + " " + extra +
                                             " >/dev/null 2>" + err.string());
   return {code, daemon_test::slurp(err)};

@@ -33,11 +33,6 @@ bool Protocol::checksum_ok(std::span<const std::uint8_t> frame) const noexcept {
   return frame[at] == (expected >> 8) && frame[at + 1] == (expected & 0xFF);
 }
 
-std::uint64_t Framer::frames_of(std::uint8_t msg_class, std::uint8_t msg_id) const {
-  const auto it = by_type_.find(static_cast<std::uint16_t>((msg_class << 8) | msg_id));
-  return it == by_type_.end() ? 0 : it->second;
-}
-
 namespace {
 
 struct Name {

@@ -51,6 +51,95 @@ Decoded<T> failure(PayloadError error) noexcept {
   return d;
 }
 
+// The layouts of the messages trajroi both decodes and encodes are described once, as a walk
+// over their fields (offset, width, bit): the decoder walks it with a FieldReader, the encoder
+// with a FieldWriter over a zeroed payload, so the two cannot disagree.
+struct FieldReader {
+  std::span<const std::uint8_t> p;
+  void u8(std::size_t at, std::uint8_t& v) const noexcept { v = p[at]; }
+  void i8(std::size_t at, std::int8_t& v) const noexcept { v = le_i8(p, at); }
+  void u16(std::size_t at, std::uint16_t& v) const noexcept { v = le_u16(p, at); }
+  void u32(std::size_t at, std::uint32_t& v) const noexcept { v = le_u32(p, at); }
+  void i32(std::size_t at, std::int32_t& v) const noexcept { v = le_i32(p, at); }
+  void flag(std::size_t at, unsigned mask, bool& v) const noexcept { v = (p[at] & mask) != 0; }
+  void carrier(std::size_t at, unsigned shift, CarrierSolution& v) const noexcept { v = carrier_solution(p[at] >> shift); }
+};
+
+struct FieldWriter {
+  std::vector<std::uint8_t>& p;
+  void put(std::size_t at, std::uint32_t v, std::size_t bytes) const {
+    for (std::size_t k = 0; k < bytes; ++k) p[at + k] = static_cast<std::uint8_t>(v >> (8 * k));
+  }
+  void u8(std::size_t at, std::uint8_t v) const { p[at] = v; }
+  void i8(std::size_t at, std::int8_t v) const { p[at] = std::bit_cast<std::uint8_t>(v); }
+  void u16(std::size_t at, std::uint16_t v) const { put(at, v, 2); }
+  void u32(std::size_t at, std::uint32_t v) const { put(at, v, 4); }
+  void i32(std::size_t at, std::int32_t v) const { put(at, std::bit_cast<std::uint32_t>(v), 4); }
+  void flag(std::size_t at, unsigned mask, bool v) const {
+    if (v) p[at] = static_cast<std::uint8_t>(p[at] | mask);
+  }
+  void carrier(std::size_t at, unsigned shift, CarrierSolution v) const {
+    p[at] = static_cast<std::uint8_t>(p[at] | (static_cast<unsigned>(v) << shift));
+  }
+};
+
+// UBX-NAV-PVT, u-blox 8 / M8 interface description 32.17.17 (`size`: 92, or 84 for protocol 14).
+template <class Io, class M>
+void walk_nav_pvt(const Io& io, M& m, std::size_t size) {
+  io.u32(0, m.itow_ms);
+  io.u16(4, m.year);
+  io.u8(6, m.month);
+  io.u8(7, m.day);
+  io.u8(8, m.hour);
+  io.u8(9, m.minute);
+  io.u8(10, m.second);
+  io.flag(11, 0x01, m.valid_date);
+  io.flag(11, 0x02, m.valid_time);
+  io.flag(11, 0x04, m.fully_resolved);
+  io.u32(12, m.time_accuracy_ns);
+  io.i32(16, m.nano_ns);
+  io.u8(20, m.fix_type_raw);
+  io.flag(21, 0x01, m.gnss_fix_ok);
+  io.flag(21, 0x02, m.diff_soln);
+  io.flag(21, 0x20, m.head_veh_valid);
+  io.carrier(21, 6, m.carr_soln);
+  io.u8(23, m.num_sv);
+  io.i32(24, m.lon_e7);
+  io.i32(28, m.lat_e7);
+  io.i32(32, m.height_mm);
+  io.i32(36, m.hmsl_mm);
+  io.u32(40, m.h_acc_mm);
+  io.u32(44, m.v_acc_mm);
+  io.i32(48, m.vel_n_mmps);
+  io.i32(52, m.vel_e_mmps);
+  io.i32(56, m.vel_d_mmps);
+  io.i32(60, m.ground_speed_mmps);
+  io.i32(64, m.head_mot_e5deg);
+  io.u32(68, m.speed_acc_mmps);
+  io.u32(72, m.head_acc_e5deg);
+  io.u16(76, m.pdop_e2);
+  io.flag(78, 0x01, m.invalid_llh);  // flags3
+  if (size == NavPvt::kBytes) io.i32(84, m.head_veh_e5deg);
+}
+
+// UBX-NAV-HPPOSLLH, 32.17.11.
+template <class Io, class M>
+void walk_nav_hpposllh(const Io& io, M& m) {
+  io.u8(0, m.version);
+  io.flag(3, 0x01, m.invalid_llh);
+  io.u32(4, m.itow_ms);
+  io.i32(8, m.lon_e7);
+  io.i32(12, m.lat_e7);
+  io.i32(16, m.height_mm);
+  io.i32(20, m.hmsl_mm);
+  io.i8(24, m.lon_hp_e9);
+  io.i8(25, m.lat_hp_e9);
+  io.i8(26, m.height_hp_e4m);
+  io.i8(27, m.hmsl_hp_e4m);
+  io.u32(28, m.h_acc_e4m);
+  io.u32(32, m.v_acc_e4m);
+}
+
 }  // namespace
 
 FixType NavPvt::fix_type() const noexcept {
@@ -75,44 +164,8 @@ Decoded<NavPvt> decode_nav_pvt(std::span<const std::uint8_t> p) noexcept {
     return failure<NavPvt>(PayloadError::kWrongLength);
   }
   Decoded<NavPvt> d;
-  NavPvt& m = d.value;
-  m.itow_ms = le_u32(p, 0);
-  m.year = le_u16(p, 4);
-  m.month = p[6];
-  m.day = p[7];
-  m.hour = p[8];
-  m.minute = p[9];
-  m.second = p[10];
-  m.valid_date = (p[11] & 0x01) != 0;
-  m.valid_time = (p[11] & 0x02) != 0;
-  m.fully_resolved = (p[11] & 0x04) != 0;
-  m.time_accuracy_ns = le_u32(p, 12);
-  m.nano_ns = le_i32(p, 16);
-  m.fix_type_raw = p[20];
-  m.gnss_fix_ok = (p[21] & 0x01) != 0;
-  m.diff_soln = (p[21] & 0x02) != 0;
-  m.head_veh_valid = (p[21] & 0x20) != 0;
-  m.carr_soln = carrier_solution(p[21] >> 6U);
-  m.num_sv = p[23];
-  m.lon_e7 = le_i32(p, 24);
-  m.lat_e7 = le_i32(p, 28);
-  m.height_mm = le_i32(p, 32);
-  m.hmsl_mm = le_i32(p, 36);
-  m.h_acc_mm = le_u32(p, 40);
-  m.v_acc_mm = le_u32(p, 44);
-  m.vel_n_mmps = le_i32(p, 48);
-  m.vel_e_mmps = le_i32(p, 52);
-  m.vel_d_mmps = le_i32(p, 56);
-  m.ground_speed_mmps = le_i32(p, 60);
-  m.head_mot_e5deg = le_i32(p, 64);
-  m.speed_acc_mmps = le_u32(p, 68);
-  m.head_acc_e5deg = le_u32(p, 72);
-  m.pdop_e2 = le_u16(p, 76);
-  m.invalid_llh = (p[78] & 0x01) != 0;
-  if (p.size() == NavPvt::kBytes) {
-    m.has_head_veh = true;
-    m.head_veh_e5deg = le_i32(p, 84);
-  }
+  walk_nav_pvt(FieldReader{p}, d.value, p.size());
+  d.value.has_head_veh = p.size() == NavPvt::kBytes;
   return d;
 }
 
@@ -120,20 +173,7 @@ Decoded<NavHpposllh> decode_nav_hpposllh(std::span<const std::uint8_t> p) noexce
   if (p.size() != NavHpposllh::kBytes) return failure<NavHpposllh>(PayloadError::kWrongLength);
   if (p[0] > 1) return failure<NavHpposllh>(PayloadError::kUnsupportedVersion);
   Decoded<NavHpposllh> d;
-  NavHpposllh& m = d.value;
-  m.version = p[0];
-  m.invalid_llh = (p[3] & 0x01) != 0;
-  m.itow_ms = le_u32(p, 4);
-  m.lon_e7 = le_i32(p, 8);
-  m.lat_e7 = le_i32(p, 12);
-  m.height_mm = le_i32(p, 16);
-  m.hmsl_mm = le_i32(p, 20);
-  m.lon_hp_e9 = le_i8(p, 24);
-  m.lat_hp_e9 = le_i8(p, 25);
-  m.height_hp_e4m = le_i8(p, 26);
-  m.hmsl_hp_e4m = le_i8(p, 27);
-  m.h_acc_e4m = le_u32(p, 28);
-  m.v_acc_e4m = le_u32(p, 32);
+  walk_nav_hpposllh(FieldReader{p}, d.value);
   return d;
 }
 
@@ -228,54 +268,15 @@ Decoded<Ack> decode_ack(std::uint8_t msg_id, std::span<const std::uint8_t> p) no
   return d;
 }
 
-namespace {
-
-void put_u8(std::vector<std::uint8_t>& out, unsigned v) { out.push_back(static_cast<std::uint8_t>(v)); }
-void put_i8(std::vector<std::uint8_t>& out, std::int8_t v) { out.push_back(std::bit_cast<std::uint8_t>(v)); }
-void put_i32(std::vector<std::uint8_t>& out, std::int32_t v) { framing::put_le_u32(out, std::bit_cast<std::uint32_t>(v)); }
-
-}  // namespace
-
 std::vector<std::uint8_t> encode_nav_pvt(const NavPvt& m) {
-  std::vector<std::uint8_t> p;
-  p.reserve(NavPvt::kBytes);
-  framing::put_le_u32(p, m.itow_ms);
-  framing::put_le_u16(p, m.year);
-  for (const unsigned v : {unsigned{m.month}, unsigned{m.day}, unsigned{m.hour}, unsigned{m.minute}, unsigned{m.second}}) put_u8(p, v);
-  put_u8(p, (m.valid_date ? 0x01U : 0U) | (m.valid_time ? 0x02U : 0U) | (m.fully_resolved ? 0x04U : 0U));
-  framing::put_le_u32(p, m.time_accuracy_ns);
-  put_i32(p, m.nano_ns);
-  put_u8(p, m.fix_type_raw);
-  put_u8(p, (m.gnss_fix_ok ? 0x01U : 0U) | (m.diff_soln ? 0x02U : 0U) | (m.head_veh_valid ? 0x20U : 0U) |
-                (static_cast<unsigned>(m.carr_soln) << 6U));
-  put_u8(p, 0);  // flags2
-  put_u8(p, m.num_sv);
-  for (const std::int32_t v : {m.lon_e7, m.lat_e7, m.height_mm, m.hmsl_mm}) put_i32(p, v);
-  framing::put_le_u32(p, m.h_acc_mm);
-  framing::put_le_u32(p, m.v_acc_mm);
-  for (const std::int32_t v : {m.vel_n_mmps, m.vel_e_mmps, m.vel_d_mmps, m.ground_speed_mmps, m.head_mot_e5deg}) put_i32(p, v);
-  framing::put_le_u32(p, m.speed_acc_mmps);
-  framing::put_le_u32(p, m.head_acc_e5deg);
-  framing::put_le_u16(p, m.pdop_e2);
-  framing::put_le_u16(p, m.invalid_llh ? 0x01 : 0x00);  // flags3
-  framing::put_le_u32(p, 0);                             // reserved
-  put_i32(p, m.head_veh_e5deg);
-  framing::put_le_u32(p, 0);                             // magDec, magAcc
+  std::vector<std::uint8_t> p(NavPvt::kBytes, 0);
+  walk_nav_pvt(FieldWriter{p}, m, NavPvt::kBytes);
   return encode_frame(kClassNav, kIdNavPvt, p);
 }
 
 std::vector<std::uint8_t> encode_nav_hpposllh(const NavHpposllh& m) {
-  std::vector<std::uint8_t> p;
-  p.reserve(NavHpposllh::kBytes);
-  put_u8(p, m.version);
-  put_u8(p, 0);
-  put_u8(p, 0);
-  put_u8(p, m.invalid_llh ? 0x01U : 0U);
-  framing::put_le_u32(p, m.itow_ms);
-  for (const std::int32_t v : {m.lon_e7, m.lat_e7, m.height_mm, m.hmsl_mm}) put_i32(p, v);
-  for (const std::int8_t v : {m.lon_hp_e9, m.lat_hp_e9, m.height_hp_e4m, m.hmsl_hp_e4m}) put_i8(p, v);
-  framing::put_le_u32(p, m.h_acc_e4m);
-  framing::put_le_u32(p, m.v_acc_e4m);
+  std::vector<std::uint8_t> p(NavHpposllh::kBytes, 0);
+  walk_nav_hpposllh(FieldWriter{p}, m);
   return encode_frame(kClassNav, kIdNavHpposllh, p);
 }
 

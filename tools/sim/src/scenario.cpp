@@ -7,6 +7,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "trajroi/config/origin.hpp"
 #include "trajroi/config/text_file.hpp"
 #include "trajroi/config/yaml_reader.hpp"
 #include "trajroi/framing/utc.hpp"
@@ -253,15 +254,8 @@ Scenario parse_scenario(std::string_view yaml_text, const std::string& source) {
   root.require(parse_utc_iso8601(start, s.start_utc_ns), "start_utc", "must be a UTC time like 2024-05-14T09:00:00Z");
   root.require(s.start_utc_ns >= 315'964'800'000'000'000 && s.start_utc_ns < 3'471'292'800'000'000'000,
                "start_utc", "must be between 1980-01-06 (the GPS epoch) and 2079");
-  {
-    MapReader origin = root.map("origin");
-    s.origin.lat_deg = origin.number("lat_deg");
-    origin.require(std::abs(s.origin.lat_deg) <= 84.0, "lat_deg", "must be within ±84°");
-    s.origin.lon_deg = origin.number("lon_deg");
-    origin.require(std::abs(s.origin.lon_deg) <= 180.0, "lon_deg", "must be within ±180°");
-    s.origin.height_m = origin.number("height_m", 0.0);
-    origin.finish();
-  }
+  const config::Origin origin = config::read_origin(root.map("origin"));
+  s.origin = pose::Geodetic{origin.lat_deg, origin.lon_deg, origin.height_m};
   s.world = read_world(root.map("world"));
   s.path = read_path(root.map("trajectory"));
   s.robot = read_robot(root.map("robot", true));

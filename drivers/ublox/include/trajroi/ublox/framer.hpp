@@ -70,7 +70,6 @@ class Framer {
   [[nodiscard]] const framing::FramerCounters& counters() const noexcept { return framer_.counters(); }
   // Good frames by Message::key(), in key order.
   [[nodiscard]] const std::map<std::uint16_t, std::uint64_t>& frames_by_type() const noexcept { return by_type_; }
-  [[nodiscard]] std::uint64_t frames_of(std::uint8_t msg_class, std::uint8_t msg_id) const;
 
  private:
   template <class Sink>
