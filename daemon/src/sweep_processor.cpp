@@ -81,13 +81,14 @@ void Sweep::clear_points() noexcept {
   ring.clear();
   return_type.clear();
   time_offset_ns.clear();
+  point_index.clear();
 }
 
 // Routes the stream decoder's callbacks to the processor and on to the caller's sink.
 class SweepProcessor::FrameAdapter final : public vlp16::FrameSink {
  public:
   FrameAdapter(SweepProcessor& processor, SweepSink& sink) : processor_(processor), sink_(sink) {}
-  void on_points(const vlp16::Frame& frame, std::size_t first) override { processor_.add_points(frame, first); }
+  void on_points(const vlp16::Frame& frame, std::size_t first) override { processor_.add_points(frame, first, sink_); }
   void on_frame(const vlp16::Frame& frame) override { processor_.end_sweep(frame, sink_); }
 
  private:
@@ -138,6 +139,11 @@ void SweepProcessor::lidar_datagram(LidarPort port, std::span<const std::uint8_t
 void SweepProcessor::flush(SweepSink& sink) {
   FrameAdapter adapter(*this, sink);
   decoder_.flush(adapter);
+}
+
+void SweepProcessor::keep_point_indices() {
+  keep_indices_ = true;
+  sweep_.point_index.reserve(config_.buffers.max_points_per_sweep);
 }
 
 void SweepProcessor::offer_trajectory(std::unique_ptr<ActiveTrajectory> trajectory) {
@@ -231,14 +237,14 @@ void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
   }
 }
 
-void SweepProcessor::add_points(const vlp16::Frame& frame, std::size_t first) {
+void SweepProcessor::add_points(const vlp16::Frame& frame, std::size_t first, SweepSink& sink) {
   if (first == 0 || !in_sweep_) start_sweep(frame);
   sweep_.last_packet_arrival_ns = arrival_ns_;
   const std::size_t end = frame.points.size();
   if (!sweep_.filtered) return;
   if (config_.pose_mode == PoseMode::kPerSweep) {
     for (std::size_t i = first; i < end; i += kScratchPoints) {
-      filter_run(frame, i, std::min(end, i + kScratchPoints), sweep_sensor_pose_);
+      filter_run(frame, i, std::min(end, i + kScratchPoints), sweep_sensor_pose_, sink);
     }
     return;
   }
@@ -262,13 +268,13 @@ void SweepProcessor::add_points(const vlp16::Frame& frame, std::size_t first) {
       if (firing_.generation() != generation) break;
       ++j;
     }
-    filter_run(frame, i, j, global_from_lidar);
+    filter_run(frame, i, j, global_from_lidar, sink);
     i = j;
   }
 }
 
 void SweepProcessor::filter_run(const vlp16::Frame& frame, std::size_t first, std::size_t end,
-                                const Eigen::Isometry3d& global_from_lidar) {
+                                const Eigen::Isometry3d& global_from_lidar, SweepSink& sink) {
   scratch_.resize(end - first);
   for (std::size_t i = first; i < end; ++i) {
     const vlp16::Point& p = frame.points[i];
@@ -276,6 +282,7 @@ void SweepProcessor::filter_run(const vlp16::Frame& frame, std::size_t first, st
   }
   roi::transform_points(global_from_lidar, scratch_, scratch_);
   const std::span<const roi::PointXYZI> placed(scratch_);
+  sink.on_placed(frame, first, placed);
   if (config_.roi.shape == RoiShape::kCircular) {
     (void)circle_grid_.filter(placed, kept_);
   } else {
@@ -295,6 +302,9 @@ void SweepProcessor::filter_run(const vlp16::Frame& frame, std::size_t first, st
     s.ring.push_back(p.ring);
     s.return_type.push_back(static_cast<std::uint8_t>(p.return_type));
     s.time_offset_ns.push_back(static_cast<std::int32_t>(p.time_offset_ns));
+  }
+  if (keep_indices_) {
+    for (std::size_t k = 0; k < n; ++k) s.point_index.push_back(static_cast<std::uint32_t>(first + kept_[k]));
   }
 }
 

@@ -15,6 +15,8 @@
 #include "reload.hpp"
 #include "trajroi/daemon/config.hpp"
 #include "trajroi/daemon/sweep_processor.hpp"
+#include "trajroi/eval/scenario_eval.hpp"
+#include "trajroi/inputs/recorded_input.hpp"
 #include "trajroi/inputs/pacer.hpp"
 #include "trajroi/inputs/run_merger.hpp"
 #include "trajroi/points_t.hpp"
@@ -193,6 +195,55 @@ TEST(Pipeline, OneRecordedLaneIsExactlyTheProcessorsOutput) {
     published[m.sweep_index] = static_cast<std::size_t>(m.num_points);
   }
   EXPECT_EQ(published, reference_kept(config));
+}
+
+// The evaluation (trajroi eval) runs the daemon's own pipeline: for the same run and the same
+// configuration it keeps exactly the points trajroid publishes, sweep by sweep.
+TEST(Pipeline, TheEvaluationKeepsExactlyWhatTheDaemonPublishes) {
+  const trajroi::eval::ScenarioRun run(corridor_run());
+  const DaemonConfig daemon_config = trajroi::daemon::load_daemon_config(corridor_run() / "trajroid.yaml");
+  // The daemon: the recorded run through its threads, as fast as possible (exact).
+  Pipeline pipeline(daemon_config, /*exact=*/true, /*record=*/false);
+  pipeline.add_input(std::make_unique<inputs::RecordedInput>(corridor_run(), inputs::RecordedOptions{}),
+                     daemon_config.buffers.lidar_packets, "test-replay", {});
+  SweepProcessor processor(daemon_config, trajroi::daemon::load_trajectory(daemon_config.trajectory_file));
+  FakeOutlet outlet;
+  ASSERT_EQ(trajroi::daemon::run_pipeline(pipeline, processor, outlet, {}, /*signals=*/false), 0);
+  std::map<std::int64_t, trajroi::points_t> published;
+  for (const auto& bytes : outlet.messages(daemon_config.lcm.points)) {
+    auto m = decode<trajroi::points_t>(bytes);
+    published.emplace(m.sweep_index, std::move(m));
+  }
+
+  // The evaluation: the configuration it builds for the daemon's shape and spacing.
+  const auto eval_config = run.pipeline_config(daemon_config.roi.shape,
+                                               static_cast<int>(std::lround(daemon_config.roi.spacing_ratio * 100.0)),
+                                               daemon_config.pose_mode);
+  struct Collect final : trajroi::eval::PipelineObserver {
+    std::map<std::int64_t, trajroi::daemon::Sweep> sweeps;
+    void on_sweep(std::size_t, const trajroi::daemon::Sweep& s, double) override {
+      if (s.filtered) sweeps[static_cast<std::int64_t>(s.index)] = s;
+    }
+  } collect;
+  trajroi::eval::run_pipelines(run, std::span<const DaemonConfig>(&eval_config, 1), collect);
+
+  ASSERT_GT(published.size(), 100u);
+  ASSERT_EQ(collect.sweeps.size(), published.size());
+  std::size_t points = 0;
+  for (const auto& [index, m] : published) {
+    const auto it = collect.sweeps.find(index);
+    ASSERT_NE(it, collect.sweeps.end()) << "sweep " << index;
+    const trajroi::daemon::Sweep& s = it->second;
+    ASSERT_EQ(static_cast<std::size_t>(m.num_points), s.size()) << "sweep " << index;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      ASSERT_EQ(m.x[i], s.x[i]) << "sweep " << index << " point " << i;
+      ASSERT_EQ(m.y[i], s.y[i]) << "sweep " << index << " point " << i;
+      ASSERT_EQ(m.z[i], s.z[i]) << "sweep " << index << " point " << i;
+    }
+    EXPECT_EQ(s.point_index.size(), s.size());
+    points += s.size();
+  }
+  EXPECT_GT(points, 1'000'000u);
 }
 
 }  // namespace

@@ -32,15 +32,26 @@ TEST(FactoryScenario, ReproducesThePapersKeyframeFindings) {
 
   const auto cases = eval::keyframe_cases(run, eval::PoseMode::kPerFiring);
   ASSERT_EQ(cases.size(), 3u);
-  for (const auto& c : cases) {
-    // Noise-free pose: the estimate is the truth to a millimetre.
-    const TruePose truth = run.truth().at(c.time_ns);
-    EXPECT_NEAR(c.robot_pose.translation().x(), truth.x_m, 2e-3) << c.keyframe.name;
-    EXPECT_NEAR(c.robot_pose.translation().y(), truth.y_m, 2e-3) << c.keyframe.name;
-    EXPECT_GT(c.points.size(), 20'000u);
-    for (const eval::RoiShape shape : {eval::RoiShape::kCircular, eval::RoiShape::kRectangular}) {
-      const eval::KeyframeRow far = eval::run_keyframe_row(run, c, shape, 100, 1, eval::PoseMode::kPerFiring);
-      const eval::KeyframeRow near = eval::run_keyframe_row(run, c, shape, 25, 1, eval::PoseMode::kPerFiring);
+  // Every row from one pass of the daemon's pipeline: shape × keyframe × {100 %, 25 %}.
+  constexpr eval::RoiShape kShapes[] = {eval::RoiShape::kCircular, eval::RoiShape::kRectangular};
+  constexpr int kRatios[] = {100, 25};
+  const auto rows = eval::run_keyframe_rows(run, cases, kShapes, kRatios, 1, eval::PoseMode::kPerFiring);
+  ASSERT_EQ(rows.size(), 12u);
+  for (std::size_t s = 0; s < 2; ++s) {
+    for (std::size_t k = 0; k < cases.size(); ++k) {
+      const auto& c = cases[k];
+      // Noise-free pose: the estimate is the truth to a millimetre.
+      const TruePose truth = run.truth().at(c.time_ns);
+      EXPECT_NEAR(c.robot_pose.translation().x(), truth.x_m, 2e-3) << c.keyframe.name;
+      EXPECT_NEAR(c.robot_pose.translation().y(), truth.y_m, 2e-3) << c.keyframe.name;
+      EXPECT_GT(c.points.size(), 20'000u);
+      const eval::RoiShape shape = kShapes[s];
+      const eval::KeyframeRow& far = rows[(s * cases.size() + k) * 2];
+      const eval::KeyframeRow& near = rows[(s * cases.size() + k) * 2 + 1];
+      ASSERT_EQ(far.ratio_pct, 100);
+      ASSERT_EQ(near.ratio_pct, 25);
+      ASSERT_EQ(near.shape, shape);
+      ASSERT_EQ(near.keyframe, c.keyframe.name);
       const std::string what = c.keyframe.name + " " + std::string(eval::to_string(shape));
       // "All classification evaluation metrics have values of 0.99 or higher at the
       // shortest distance."
@@ -57,8 +68,8 @@ TEST(FactoryScenario, ReproducesThePapersKeyframeFindings) {
     }
   }
   // Keyframe 1 is straight for the whole look-ahead: the rectangles match the corridor.
-  const eval::KeyframeRow straight = eval::run_keyframe_row(run, cases[0], eval::RoiShape::kRectangular, 25, 1,
-                                                            eval::PoseMode::kPerFiring);
+  const eval::KeyframeRow& straight = rows[(1 * cases.size() + 0) * 2 + 1];
+  EXPECT_EQ(straight.shape, eval::RoiShape::kRectangular);
   EXPECT_EQ(straight.confusion.fp, 0u);
   EXPECT_EQ(straight.confusion.fn, 0u);
   std::filesystem::remove_all(dir);

@@ -24,19 +24,20 @@ struct ScenarioEvalOptions {
   std::string format = "table";
   std::string svg_dir;
   std::string pose = "per-firing";
-  int reps = 100;
+  int reps = 3;  // keyframes: passes of the whole run (every row of a pass at once)
 };
 
+// "per-frame" is the older name of per-sweep (one pose for the whole sweep, the paper's way).
 eval::PoseMode pose_mode(const std::string& name) {
-  return name == "per-frame" ? eval::PoseMode::kPerFrame : eval::PoseMode::kPerFiring;
+  return name == "per-sweep" || name == "per-frame" ? eval::PoseMode::kPerSweep : eval::PoseMode::kPerFiring;
 }
 
 void add_common_options(CLI::App* cmd, ScenarioEvalOptions& o) {
   cmd->add_option("--scenario", o.scenario, "Run folder written by `trajroi sim`")->required();
   cmd->add_option("--format", o.format, "Output format")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
   cmd->add_option("--svg", o.svg_dir, "Also write SVG pictures into this folder");
-  cmd->add_option("--pose", o.pose, "Pose per firing sequence (motion-compensated) or one per frame (the paper)")
-      ->check(CLI::IsMember({"per-firing", "per-frame"}))
+  cmd->add_option("--pose", o.pose, "Pose per firing sequence (motion-compensated) or one per sweep (the paper)")
+      ->check(CLI::IsMember({"per-firing", "per-sweep", "per-frame"}))
       ->capture_default_str();
 }
 
@@ -89,17 +90,22 @@ void run_keyframes(const ScenarioEvalOptions& o) {
   if (csv) std::printf("keyframe,shape,ratio_pct,num_roi,tp,fp,fn,tn,precision,recall,accuracy,min_ms,max_ms,avg_ms\n");
   if (json) std::printf("{\"scenario\": \"%s\", \"pose\": \"%s\", \"reps\": %d, \"rows\": [", run.scenario().name.c_str(), o.pose.c_str(), o.reps);
   bool first_row = true;
-  for (const eval::RoiShape shape : {eval::RoiShape::kCircular, eval::RoiShape::kRectangular}) {
+  // Every row from the daemon's pipeline: one pass of the run per repetition, every shape and
+  // spacing at once.
+  constexpr eval::RoiShape kShapes[] = {eval::RoiShape::kCircular, eval::RoiShape::kRectangular};
+  const std::vector<eval::KeyframeRow> rows = eval::run_keyframe_rows(run, cases, kShapes, kKeyframeRatiosPct, o.reps, mode);
+  std::size_t next_row = 0;
+  for (const eval::RoiShape shape : kShapes) {
     for (const eval::KeyframeCase& c : cases) {
       if (!csv && !json) {
-        std::printf("\n%s, %s ROI — frame %llu, %zu points, robot at (%.2f, %.2f); times over %d repetitions [ms]\n",
+        std::printf("\n%s, %s ROI — frame %llu, %zu points, robot at (%.2f, %.2f); times over %d passes [ms]\n",
                     c.keyframe.name.c_str(), shape_name(shape).c_str(), static_cast<unsigned long long>(c.frame_index),
                     c.points.size(), c.robot_pose.translation().x(), c.robot_pose.translation().y(), o.reps);
         std::printf("%6s %5s %7s %6s %6s %7s %9s %7s %8s %8s %8s %8s\n", "ratio", "#ROI", "TP", "FP", "FN", "TN",
                     "precision", "recall", "accuracy", "min", "max", "avg");
       }
       for (const int ratio : kKeyframeRatiosPct) {
-        const eval::KeyframeRow row = eval::run_keyframe_row(run, c, shape, ratio, o.reps, mode);
+        const eval::KeyframeRow& row = rows[next_row++];
         const roi::Confusion& k = row.confusion;
         const auto u = [](std::uint64_t v) { return static_cast<unsigned long long>(v); };
         if (csv) {
@@ -326,7 +332,7 @@ void add_scenario_eval_commands(CLI::App& eval_cmd) {
     CLI::App* cmd = eval_cmd.add_subcommand(entry.name, entry.help);
     add_common_options(cmd, *options);
     if (entry.run == run_keyframes) {
-      cmd->add_option("--reps", options->reps, "Timed repetitions per row")->check(CLI::Range(1, 100000))->capture_default_str();
+      cmd->add_option("--reps", options->reps, "Timed passes of the run (keyframes: every row in each pass)")->check(CLI::Range(1, 100000))->capture_default_str();
     }
     const auto run = entry.run;
     cmd->callback([options, run] { run(*options); });

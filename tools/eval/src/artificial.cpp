@@ -14,9 +14,6 @@ std::string_view to_string(ArtificialData data) noexcept {
   return data == ArtificialData::kStraight ? "straight" : "curved";
 }
 
-std::string_view to_string(RoiShape shape) noexcept {
-  return shape == RoiShape::kCircular ? "circular" : "rectangular";
-}
 
 namespace {
 

@@ -1,6 +1,8 @@
 #include "trajroi/eval/scenario_eval.hpp"
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -8,6 +10,7 @@
 #include <stdexcept>
 
 #include "trajroi/config/yaml_reader.hpp"
+#include "trajroi/daemon/sweep_processor.hpp"
 #include "trajroi/roi/grid_filter.hpp"
 #include "trajroi/roi/shapes.hpp"
 #include "trajroi/roi/transform.hpp"
@@ -72,19 +75,21 @@ ScenarioRun::ScenarioRun(const fs::path& dir) : dir_(dir) {
   trajectory_ = std::make_unique<roi::Trajectory>(
       roi::parse_trajectory_csv(config::read_text_file(dir / sim::kTrajectoryFile), (dir / sim::kTrajectoryFile).string()));
   robot_from_lidar_ = scenario_.robot.lidar.robot_from_sensor();
+  // The daemon's configuration the simulator wrote for this run: sensors, delays, ranges.
+  config_ = daemon::load_daemon_config(dir / sim::kDaemonConfigFile);
 
-  // The pose, from the recorded streams through the drivers and the pose library. The gate
-  // is the daemon's default; the buffer holds the whole run (an offline evaluation).
-  pose::PoseGate gate;
+  // The pose over the whole run (for the keyframes' descriptions: the estimated robot pose at
+  // the keyframe's time), from the recordings through the daemon's pose input, in the order
+  // the daemon's merger gives them (an attitude is turned into the global frame at the latest
+  // GNSS position).
   const std::size_t capacity = 1U << 20;
-  poses_ = std::make_unique<pose::PoseBuffer>(gate, scenario_.robot.gnss_antenna_m, capacity);
-  pose_input::PoseInputConfig config;
-  config.imu.magnetic_declination_deg = scenario_.imu.magnetic_declination_deg;
-  config.gnss_delay_ns = std::llround(sim::gnss_delay_s(scenario_.gnss) * 1e9);
-  config.imu_delay_ns = std::llround(sim::imu_delay_s(scenario_.imu) * 1e9);
-  pose_input::PoseInput input(pose::GlobalFrame::local_cartesian(scenario_.origin), config, *poses_);
-  // The two recordings in receive-time order (the daemon's merger), as a live daemon gets
-  // them (an attitude is turned into the global frame at the latest GNSS position).
+  poses_ = std::make_unique<pose::PoseBuffer>(config_.gate, config_.gnss_antenna_m, capacity);
+  pose_input::PoseInputConfig input_config;
+  input_config.imu.robot_from_imu = config_.robot_from_imu;
+  input_config.imu.magnetic_declination_deg = config_.magnetic_declination_deg;
+  input_config.gnss_delay_ns = std::llround(config_.gnss.delay_s * 1e9);
+  input_config.imu_delay_ns = std::llround(config_.imu.delay_s * 1e9);
+  pose_input::PoseInput input(pose::GlobalFrame::local_cartesian(config_.origin), input_config, *poses_);
   inputs::RunMerger merger(dir, inputs::RunStreams{false, true, true});
   inputs::InputItem item;
   while (merger.next(item)) {
@@ -101,6 +106,30 @@ ScenarioRun::ScenarioRun(const fs::path& dir) : dir_(dir) {
 
 ScenarioRun::~ScenarioRun() = default;
 
+vlp16::StreamOptions ScenarioRun::stream_options() const {
+  vlp16::StreamOptions o;
+  o.decode.min_range_m = config_.lidar.min_range_m;
+  o.decode.max_range_m = config_.lidar.max_range_m;
+  o.cut_azimuth_deg = config_.lidar.cut_azimuth_deg;
+  return o;
+}
+
+daemon::DaemonConfig ScenarioRun::pipeline_config(RoiShape shape, int ratio_pct, daemon::PoseMode mode) const {
+  daemon::DaemonConfig c = config_;
+  const sim::EvaluationSpec& e = scenario_.evaluation;
+  c.roi.shape = shape;
+  c.roi.circle_diameter_m = e.circle_diameter_m;
+  c.roi.rect_height_m = e.rect_height_m;
+  c.roi.rect_width_m = e.rect_width_m;
+  c.roi.spacing_ratio = ratio_pct / 100.0;
+  c.roi.look_ahead_m = e.look_ahead_m;
+  c.roi.look_ahead_per_mps_s = 0.0;
+  c.roi.width_per_mps_s = 0.0;
+  c.pose_mode = mode;
+  c.buffers.max_points_per_sweep = 1U << 20;  // never truncate what is scored
+  return c;
+}
+
 vlp16::StreamCounters ScenarioRun::for_each_frame(const FrameCallback& on_frame) const {
   struct Sink final : vlp16::FrameSink {
     const FrameCallback* callback;
@@ -113,7 +142,7 @@ vlp16::StreamCounters ScenarioRun::for_each_frame(const FrameCallback& on_frame)
     }
   } sink;
   sink.callback = &on_frame;
-  vlp16::StreamDecoder decoder(vlp16::Calibration::vlp16_default(), {});
+  vlp16::StreamDecoder decoder(vlp16::Calibration::vlp16_default(), stream_options());
   vlp16::PcapSource source(dir_ / sim::kLidarFile);
   inputs::CaptureDecoder capture(source, decoder);
   for (;;) {
@@ -128,31 +157,73 @@ vlp16::StreamCounters ScenarioRun::for_each_frame(const FrameCallback& on_frame)
   return decoder.counters();
 }
 
-// ---- placing frames -----------------------------------------------------------------------
+std::string_view to_string(PoseMode mode) noexcept { return mode == PoseMode::kPerSweep ? "per-sweep" : "per-firing"; }
 
-bool place_frame(const vlp16::Frame& frame, const pose::PoseBuffer& poses, const Eigen::Isometry3d& robot_from_lidar,
-                 PoseMode mode, std::vector<roi::PointXYZI>& out, pose::PoseStatus& status) {
-  out.clear();
-  out.reserve(frame.points.size());
-  // Per frame: one query at the frame's middle, a period longer than any frame.
-  const bool per_frame = mode == PoseMode::kPerFrame;
-  pose::FiringPoses firing(poses, robot_from_lidar,
-                           per_frame ? std::numeric_limits<std::int64_t>::max() : vlp16::kFiringCycle_ns);
-  const Eigen::Isometry3d* global_from_lidar = nullptr;
-  if (per_frame) {
-    global_from_lidar = firing.at(frame.start_time_ns + (frame.end_time_ns - frame.start_time_ns) / 2, status);
-    if (global_from_lidar == nullptr) return false;
-  }
-  for (const vlp16::Point& p : frame.points) {
-    if (!per_frame) {
-      global_from_lidar = firing.at(frame.start_time_ns + p.time_offset_ns, status);
-      if (global_from_lidar == nullptr) return false;
+// ---- the daemon's pipeline ------------------------------------------------------------------
+
+void run_pipelines(const ScenarioRun& run, std::span<const daemon::DaemonConfig> configs, PipelineObserver& observer,
+                   std::int64_t until_ns) {
+  // Per configuration: its processor, and a sink that times the packets of each sweep.
+  struct Lane final : daemon::SweepSink {
+    std::size_t index = 0;
+    PipelineObserver* observer = nullptr;
+    std::unique_ptr<daemon::SweepProcessor> processor;
+    double sweep_ms = 0.0;
+    std::chrono::steady_clock::time_point packet_start;
+    bool past_end = false;
+    std::int64_t until_ns = 0;
+    void on_sweep(const daemon::Sweep& sweep) override {
+      sweep_ms += elapsed_ms(packet_start);
+      observer->on_sweep(index, sweep, sweep_ms);
+      sweep_ms = 0.0;
+      packet_start = std::chrono::steady_clock::now();
+      past_end = past_end || sweep.end_ns >= until_ns;
     }
-    push_point(out, *global_from_lidar * Eigen::Vector3d(p.x, p.y, p.z), static_cast<float>(p.intensity));
+    void on_placed(const vlp16::Frame& frame, std::size_t first, std::span<const roi::PointXYZI> placed) override {
+      observer->on_placed(index, frame, first, placed);
+    }
+  };
+  std::vector<Lane> lanes(configs.size());
+  for (std::size_t k = 0; k < configs.size(); ++k) {
+    lanes[k].index = k;
+    lanes[k].observer = &observer;
+    lanes[k].until_ns = until_ns;
+    lanes[k].processor = std::make_unique<daemon::SweepProcessor>(
+        configs[k], std::make_unique<daemon::ActiveTrajectory>(daemon::ActiveTrajectory{run.trajectory(), 0}));
+    lanes[k].processor->keep_point_indices();
   }
-  status = pose::PoseStatus::kValid;
-  return true;
+  inputs::RunMerger merger(run.dir());
+  inputs::InputItem item;
+  bool all_past = configs.empty();
+  while (!all_past && merger.next(item)) {
+    all_past = true;
+    for (Lane& lane : lanes) {
+      daemon::SweepProcessor& p = *lane.processor;
+      switch (item.stream) {
+        case inputs::Stream::kGnss: p.gnss_bytes(item.bytes, item.receive_ns); break;
+        case inputs::Stream::kImu: p.imu_bytes(item.bytes, item.receive_ns); break;
+        case inputs::Stream::kLidarData:
+        case inputs::Stream::kLidarPosition: {
+          lane.packet_start = std::chrono::steady_clock::now();
+          p.lidar_datagram(item.stream == inputs::Stream::kLidarData ? daemon::LidarPort::kData : daemon::LidarPort::kPosition,
+                           item.bytes, item.receive_ns, lane);
+          lane.sweep_ms += elapsed_ms(lane.packet_start);
+          lane.packet_start = std::chrono::steady_clock::now();
+          break;
+        }
+      }
+      all_past = all_past && lane.past_end;
+    }
+  }
+  if (!all_past) {
+    for (Lane& lane : lanes) {
+      lane.packet_start = std::chrono::steady_clock::now();
+      lane.processor->flush(lane);
+    }
+  }
 }
+
+// ---- placing frames -----------------------------------------------------------------------
 
 void place_frame_truth(const vlp16::Frame& frame, const sim::TruthPoses& truth,
                        const Eigen::Isometry3d& robot_from_lidar, std::vector<roi::PointXYZd>& out) {
@@ -188,111 +259,186 @@ std::vector<KeyframeCase> keyframe_cases(const ScenarioRun& run, PoseMode mode) 
     }
     cases[k].keyframe = kf;
   }
-  std::vector<bool> found(cases.size(), false);
+  std::vector<std::uint8_t> found(cases.size(), 0);
   run.for_each_frame([&](const vlp16::Frame& frame, std::uint64_t, double) {
     if (frame.partial) return;
     for (std::size_t k = 0; k < cases.size(); ++k) {
-      if (!found[k] && frame.start_time_ns <= cases[k].time_ns && cases[k].time_ns < frame.end_time_ns) {
+      if (found[k] == 0 && frame.start_time_ns <= cases[k].time_ns && cases[k].time_ns < frame.end_time_ns) {
         cases[k].frame = frame;
         cases[k].frame_index = frame.index;
-        found[k] = true;
+        found[k] = 1;
       }
     }
   });
+  std::int64_t last_end = std::numeric_limits<std::int64_t>::min();
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    if (found[k] == 0) throw std::runtime_error(run.dir().string() + ": no complete frame at keyframe '" + cases[k].keyframe.name + "'");
+    last_end = std::max(last_end, cases[k].frame.end_time_ns);
+  }
+  // The keyframes' sweeps through the daemon's pipeline: their points as it places them, the
+  // robot's projection where it starts the chain.
+  struct Collect final : PipelineObserver {
+    std::vector<KeyframeCase>* cases;
+    std::vector<std::uint8_t> placed_ok;
+    std::vector<pose::PoseStatus> status;
+    void on_placed(std::size_t, const vlp16::Frame& frame, std::size_t first, std::span<const roi::PointXYZI> placed) override {
+      for (KeyframeCase& c : *cases) {
+        if (c.frame.start_time_ns != frame.start_time_ns) continue;
+        if (c.points.size() < first + placed.size()) c.points.resize(first + placed.size());
+        std::copy(placed.begin(), placed.end(), c.points.begin() + static_cast<std::ptrdiff_t>(first));
+      }
+    }
+    void on_sweep(std::size_t, const daemon::Sweep& sweep, double) override {
+      for (std::size_t k = 0; k < cases->size(); ++k) {
+        KeyframeCase& c = (*cases)[k];
+        if (c.frame.start_time_ns != sweep.start_ns) continue;
+        placed_ok[k] = sweep.filtered ? 1 : 0;
+        status[k] = sweep.pose_status;
+        c.s0_m = sweep.start_s_m;
+      }
+    }
+  } collect;
+  collect.cases = &cases;
+  collect.placed_ok.assign(cases.size(), 0);
+  collect.status.assign(cases.size(), pose::PoseStatus::kNoGnss);
+  const daemon::DaemonConfig config = run.pipeline_config(RoiShape::kCircular, 25, mode);
+  run_pipelines(run, std::span<const daemon::DaemonConfig>(&config, 1), collect, last_end);
   for (std::size_t k = 0; k < cases.size(); ++k) {
     KeyframeCase& c = cases[k];
-    if (!found[k]) throw std::runtime_error(run.dir().string() + ": no complete frame at keyframe '" + c.keyframe.name + "'");
-    pose::PoseStatus status{};
-    if (!place_frame(c.frame, run.poses(), run.robot_from_lidar(), mode, c.points, status)) {
+    if (collect.placed_ok[k] == 0 || c.points.size() != c.frame.points.size()) {
       throw std::runtime_error(run.dir().string() + ": keyframe '" + c.keyframe.name + "': no valid pose (" +
-                               std::string(pose::to_string(status)) + ")");
+                               std::string(pose::to_string(collect.status[k])) + ")");
     }
     place_frame_truth(c.frame, run.truth(), run.robot_from_lidar(), c.truth);
     const pose::PoseQuery q = run.poses().pose_at(c.time_ns);
     if (!q.valid()) throw std::runtime_error(run.dir().string() + ": keyframe '" + c.keyframe.name + "': no valid pose");
     c.robot_pose = q.global_from_robot;
-    c.s0_m = run.trajectory().project(q.global_from_robot.translation().head<2>()).s_m;
   }
   return cases;
 }
 
+std::vector<KeyframeRow> run_keyframe_rows(const ScenarioRun& run, const std::vector<KeyframeCase>& cases,
+                                           std::span<const RoiShape> shapes, std::span<const int> ratios_pct, int reps,
+                                           PoseMode mode) {
+  const sim::EvaluationSpec& e = run.scenario().evaluation;
+  std::vector<daemon::DaemonConfig> configs;
+  for (const RoiShape shape : shapes) {
+    for (const int ratio : ratios_pct) configs.push_back(run.pipeline_config(shape, ratio, mode));
+  }
+  std::vector<KeyframeRow> rows;
+  for (const RoiShape shape : shapes) {
+    for (const KeyframeCase& c : cases) {
+      for (const int ratio : ratios_pct) rows.push_back({c.keyframe.name, shape, ratio, {}, {}, {}, {}, {}});
+    }
+  }
+  std::int64_t last_end = std::numeric_limits<std::int64_t>::min();
+  for (const KeyframeCase& c : cases) last_end = std::max(last_end, c.frame.end_time_ns);
+  // Row of configuration k (shape s, ratio r) and case c.
+  const std::size_t n_ratios = ratios_pct.size();
+  const auto row_of = [&](std::size_t k, std::size_t c) -> KeyframeRow& {
+    return rows[((k / n_ratios) * cases.size() + c) * n_ratios + k % n_ratios];
+  };
+  struct Collect final : PipelineObserver {
+    const std::vector<KeyframeCase>* cases;
+    std::function<KeyframeRow&(std::size_t, std::size_t)> row;
+    std::vector<std::size_t> samples;
+    void on_sweep(std::size_t k, const daemon::Sweep& sweep, double ms) override {
+      for (std::size_t c = 0; c < cases->size(); ++c) {
+        if ((*cases)[c].frame.start_time_ns != sweep.start_ns) continue;
+        KeyframeRow& r = row(k, c);
+        r.centres = sweep.centres;
+        r.kept.assign(sweep.point_index.begin(), sweep.point_index.end());
+        add_sample(r.time, samples[static_cast<std::size_t>(&r - &row(0, 0))], ms);
+      }
+    }
+  } collect;
+  collect.cases = &cases;
+  collect.row = row_of;
+  collect.samples.assign(rows.size(), 0);
+  for (int rep = 0; rep < std::max(reps, 1); ++rep) run_pipelines(run, configs, collect, last_end);
+  for (std::size_t k = 0; k < configs.size(); ++k) {
+    for (std::size_t c = 0; c < cases.size(); ++c) {
+      KeyframeRow& row = row_of(k, c);
+      const KeyframeCase& kc = cases[c];
+      if (row.centres.empty()) {
+        throw std::runtime_error(run.dir().string() + ": keyframe '" + kc.keyframe.name + "': the pipeline gave no chain");
+      }
+      const bool circles = row.shape == RoiShape::kCircular;
+      const double half_a = circles ? 0.0 : e.rect_height_m / 2.0;
+      const TruthCorridor corridor(run.trajectory(), row.centres, half_a, circles ? e.circle_diameter_m : e.rect_width_m,
+                                   !circles);
+      row.truth.resize(kc.truth.size());
+      for (std::size_t i = 0; i < kc.truth.size(); ++i) {
+        row.truth[i] = corridor.contains(kc.truth[i].x, kc.truth[i].y) ? 1 : 0;
+      }
+      row.confusion = roi::confusion(row.kept, row.truth);
+    }
+  }
+  return rows;
+}
+
 KeyframeRow run_keyframe_row(const ScenarioRun& run, const KeyframeCase& c, RoiShape shape, int ratio_pct, int reps,
                              PoseMode mode) {
-  const sim::EvaluationSpec& e = run.scenario().evaluation;
-  KeyframeRow row{c.keyframe.name, shape, ratio_pct, {}, {}, {}, {}, {}};
-  RoiChain chain(e);
-  std::vector<roi::PointXYZI> placed;
-  pose::PoseStatus status{};
-  row.time = time_repeated(reps, [&] {
-    (void)place_frame(c.frame, run.poses(), run.robot_from_lidar(), mode, placed, status);
-    chain.run(run.trajectory(), c.s0_m, e.look_ahead_m, shape, ratio_pct, placed);
-  });
-  row.centres = chain.centres();
-  row.kept = chain.kept();
-  const bool circles = shape == RoiShape::kCircular;
-  const double half_a = circles ? 0.0 : e.rect_height_m / 2.0;
-  const TruthCorridor corridor(run.trajectory(), row.centres, half_a, circles ? e.circle_diameter_m : e.rect_width_m,
-                               !circles);
-  row.truth.resize(c.truth.size());
-  for (std::size_t i = 0; i < c.truth.size(); ++i) row.truth[i] = corridor.contains(c.truth[i].x, c.truth[i].y) ? 1 : 0;
-  row.confusion = roi::confusion(row.kept, row.truth);
-  return row;
+  const std::vector<KeyframeCase> one{c};
+  const std::array<RoiShape, 1> shapes{shape};
+  const std::array<int, 1> ratios{ratio_pct};
+  return std::move(run_keyframe_rows(run, one, shapes, ratios, reps, mode).front());
 }
 
 // ---- sequential ---------------------------------------------------------------------------
 
 SequentialReport run_sequential(const ScenarioRun& run, PoseMode mode, int ratio_pct) {
-  SequentialReport report;
-  RoiChain chain(run.scenario().evaluation);
-  const double look_ahead = run.scenario().evaluation.look_ahead_m;
-  std::vector<roi::PointXYZI> placed;
-  std::size_t n_cycle = 0, n_circ = 0, n_rect = 0;
-  std::int64_t previous_start = 0, first_start = 0;
-  bool have_previous = false;
-  double s_hint = 0.0;
-  double points_sum = 0.0;
-  run.for_each_frame([&](const vlp16::Frame& frame, std::uint64_t, double decode_ms) {
-    if (frame.partial) {
-      ++report.skipped_partial;
-      return;
-    }
-    FrameTiming ft{frame.index, 0.0, 0.0, frame.points.size(), 0.0, 0.0};
-    if (have_previous) {
-      ft.cycle_ms = static_cast<double>(frame.start_time_ns - previous_start) * 1e-6;
-      add_sample(report.cycle, n_cycle, ft.cycle_ms);
-    } else {
-      first_start = frame.start_time_ns;
-    }
-    have_previous = true;
-    previous_start = frame.start_time_ns;
-    ft.start_s = static_cast<double>(frame.start_time_ns - first_start) * 1e-9;
-
-    // Each shape is timed as the whole pipeline, so the frame is placed once per shape.
-    for (const RoiShape shape : {RoiShape::kCircular, RoiShape::kRectangular}) {
-      const auto start = std::chrono::steady_clock::now();
-      pose::PoseStatus status{};
-      if (!place_frame(frame, run.poses(), run.robot_from_lidar(), mode, placed, status)) {
-        if (shape == RoiShape::kCircular) ++report.skipped_no_pose;
+  const std::array<daemon::DaemonConfig, 2> configs{run.pipeline_config(RoiShape::kCircular, ratio_pct, mode),
+                                                    run.pipeline_config(RoiShape::kRectangular, ratio_pct, mode)};
+  struct Collect final : PipelineObserver {
+    SequentialReport report;
+    std::map<std::uint64_t, FrameTiming> frames;  // complete sweeps with a valid pose, by index
+    std::size_t n_circ = 0, n_rect = 0;
+    double points_sum = 0.0;
+    void on_sweep(std::size_t k, const daemon::Sweep& sweep, double ms) override {
+      if (sweep.partial) {
+        if (k == 0) ++report.skipped_partial;
         return;
       }
-      const pose::PoseQuery q = run.poses().pose_at(frame.end_time_ns);
-      if (!q.valid()) return;
-      const double s0 = run.trajectory().project(q.global_from_robot.translation().head<2>(), s_hint, 50.0).s_m;
-      chain.run(run.trajectory(), s0, look_ahead, shape, ratio_pct, placed);
-      const double ms = decode_ms + elapsed_ms(start);
-      if (shape == RoiShape::kCircular) {
-        ft.circular_ms = ms;
+      if (!sweep.filtered) {
+        if (k == 0) ++report.skipped_no_pose;
+        return;
+      }
+      FrameTiming& f = frames[sweep.index];
+      f.frame_index = sweep.index;
+      f.points = sweep.points_in;
+      f.start_s = static_cast<double>(sweep.start_ns) * 1e-9;  // made relative below
+      if (k == 0) {
+        f.circular_ms = ms;
         add_sample(report.circular, n_circ, ms);
       } else {
-        s_hint = s0;
-        ft.rectangular_ms = ms;
+        f.rectangular_ms = ms;
         add_sample(report.rectangular, n_rect, ms);
       }
     }
-    points_sum += static_cast<double>(frame.points.size());
-    ++report.frames;
-    report.per_frame.push_back(ft);
-  });
+  } collect;
+  run_pipelines(run, configs, collect);
+  SequentialReport report = std::move(collect.report);
+  std::size_t n_cycle = 0;
+  double points_sum = 0.0;
+  double first_start_s = 0.0, previous_start_s = 0.0;
+  bool first = true;
+  for (auto& [index, f] : collect.frames) {
+    const double start_s = f.start_s;
+    if (first) {
+      first_start_s = start_s;
+      f.cycle_ms = 0.0;
+    } else {
+      f.cycle_ms = (start_s - previous_start_s) * 1e3;
+      add_sample(report.cycle, n_cycle, f.cycle_ms);
+    }
+    first = false;
+    previous_start_s = start_s;
+    f.start_s = start_s - first_start_s;
+    points_sum += static_cast<double>(f.points);
+    report.per_frame.push_back(f);
+  }
+  report.frames = report.per_frame.size();
   report.avg_points = report.frames > 0 ? points_sum / static_cast<double>(report.frames) : 0.0;
   return report;
 }
@@ -332,41 +478,55 @@ AccumulatedReport run_accumulated(const ScenarioRun& run, PoseMode mode, int rat
     double points_sum = 0.0;
     TimingStats time[2];
   };
-  std::vector<Accumulator> acc;
-  for (const int n : kAccumulations) acc.push_back({n, 0, {}, {0, 0}, 0.0, {}});
-  AccumulatedReport report;
-  RoiChain chain(run.scenario().evaluation);
-  const double look_ahead = run.scenario().evaluation.look_ahead_m;
-  std::vector<roi::PointXYZI> placed;
-  double s_hint = 0.0;
-  run.for_each_frame([&](const vlp16::Frame& frame, std::uint64_t, double) {
-    if (frame.partial) return;
-    pose::PoseStatus status{};
-    if (!place_frame(frame, run.poses(), run.robot_from_lidar(), mode, placed, status)) return;
-    const pose::PoseQuery q = run.poses().pose_at(frame.end_time_ns);
-    if (!q.valid()) return;
-    const double s0 = run.trajectory().project(q.global_from_robot.translation().head<2>(), s_hint, 50.0).s_m;
-    s_hint = s0;
-    for (Accumulator& a : acc) {
-      a.cloud.insert(a.cloud.end(), placed.begin(), placed.end());
-      if (++a.frames < a.frames_per_cloud) continue;
-      for (const RoiShape shape : {RoiShape::kCircular, RoiShape::kRectangular}) {
-        const int k = shape == RoiShape::kCircular ? 0 : 1;
-        const auto start = std::chrono::steady_clock::now();
-        chain.run(run.trajectory(), s0, look_ahead, shape, ratio_pct, a.cloud);
-        const double ms = elapsed_ms(start);
-        add_sample(a.time[k], a.clouds[k], ms);
-        (k == 0 ? report.circular_samples : report.rectangular_samples)
-            .emplace_back(static_cast<double>(a.cloud.size()), ms);
-      }
-      a.points_sum += static_cast<double>(a.cloud.size());
-      a.cloud.clear();
-      a.frames = 0;
+  struct Collect final : PipelineObserver {
+    std::vector<Accumulator> acc;
+    AccumulatedReport report;
+    RoiChain* chain = nullptr;
+    const ScenarioRun* run = nullptr;
+    int ratio_pct = 25;
+    std::vector<roi::PointXYZI> placed;  // the sweep in progress, in the global frame
+    void on_placed(std::size_t, const vlp16::Frame& frame, std::size_t first, std::span<const roi::PointXYZI> points) override {
+      if (first == 0 || placed.size() > first) placed.clear();
+      if (placed.size() < frame.points.size()) placed.reserve(frame.points.size());
+      placed.insert(placed.end(), points.begin(), points.end());
     }
-  });
+    void on_sweep(std::size_t, const daemon::Sweep& sweep, double) override {
+      const bool whole = !sweep.partial && sweep.filtered && placed.size() == sweep.points_in;
+      if (!whole) {
+        placed.clear();
+        return;
+      }
+      const double look_ahead = run->scenario().evaluation.look_ahead_m;
+      for (Accumulator& a : acc) {
+        a.cloud.insert(a.cloud.end(), placed.begin(), placed.end());
+        if (++a.frames < a.frames_per_cloud) continue;
+        for (const RoiShape shape : {RoiShape::kCircular, RoiShape::kRectangular}) {
+          const int k = shape == RoiShape::kCircular ? 0 : 1;
+          const auto start = std::chrono::steady_clock::now();
+          chain->run(run->trajectory(), sweep.start_s_m, look_ahead, shape, ratio_pct, a.cloud);
+          const double ms = elapsed_ms(start);
+          add_sample(a.time[k], a.clouds[k], ms);
+          (k == 0 ? report.circular_samples : report.rectangular_samples)
+              .emplace_back(static_cast<double>(a.cloud.size()), ms);
+        }
+        a.points_sum += static_cast<double>(a.cloud.size());
+        a.cloud.clear();
+        a.frames = 0;
+      }
+      placed.clear();
+    }
+  } collect;
+  for (const int n : kAccumulations) collect.acc.push_back({n, 0, {}, {0, 0}, 0.0, {}});
+  RoiChain chain(run.scenario().evaluation);
+  collect.chain = &chain;
+  collect.run = &run;
+  collect.ratio_pct = ratio_pct;
+  const daemon::DaemonConfig config = run.pipeline_config(RoiShape::kCircular, ratio_pct, mode);
+  run_pipelines(run, std::span<const daemon::DaemonConfig>(&config, 1), collect);
+  AccumulatedReport report = std::move(collect.report);
   for (const RoiShape shape : {RoiShape::kCircular, RoiShape::kRectangular}) {
     const int k = shape == RoiShape::kCircular ? 0 : 1;
-    for (const Accumulator& a : acc) {
+    for (const Accumulator& a : collect.acc) {
       if (a.clouds[k] == 0) continue;
       report.rows.push_back({shape, a.frames_per_cloud, a.clouds[k], a.points_sum / static_cast<double>(a.clouds[k]),
                              a.time[k]});

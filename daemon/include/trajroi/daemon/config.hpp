@@ -15,13 +15,14 @@
 #include "trajroi/config/yaml_reader.hpp"
 #include "trajroi/pose/geodetic.hpp"
 #include "trajroi/pose/pose_buffer.hpp"
+#include "trajroi/roi/shapes.hpp"
 
 namespace trajroi::daemon {
 
 // Exit code for a configuration error (sysexits.h EX_CONFIG); systemd does not restart it.
 inline constexpr int kExitConfig = 78;
 
-enum class RoiShape : std::uint8_t { kCircular, kRectangular };
+using roi::RoiShape;
 enum class PoseMode : std::uint8_t { kPerFiring, kPerSweep };
 enum class SchedPolicy : std::uint8_t { kOther, kFifo, kRr };
 

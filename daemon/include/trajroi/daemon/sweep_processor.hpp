@@ -85,6 +85,9 @@ struct Sweep {
   std::vector<float> x, y, z;
   std::vector<std::uint8_t> intensity, ring, return_type;
   std::vector<std::int32_t> time_offset_ns;
+  // With SweepProcessor::keep_point_indices(): each kept point's index among the decoded
+  // sweep's points (vlp16::Frame::points), for scoring against per-point truth.
+  std::vector<std::uint32_t> point_index;
 
   // Steady-clock bookkeeping: when the last datagram with points of this sweep arrived (set
   // from set_input_arrival), and the processing time the wiring measured.
@@ -103,6 +106,10 @@ class SweepSink {
   virtual ~SweepSink() = default;
   // `sweep` is valid during the call only.
   virtual void on_sweep(const Sweep& sweep) = 0;
+  // Every run of points as placed in the global frame, before the ROI: `placed[k]` is the
+  // frame's point `first + k`. Only while the sweep's pose is valid. For the evaluations.
+  virtual void on_placed(const vlp16::Frame& /*frame*/, std::size_t /*first*/,
+                         std::span<const roi::PointXYZI> /*placed*/) {}
 };
 
 struct ProcessorCounters {
@@ -130,6 +137,8 @@ class SweepProcessor {
   void set_input_arrival(std::int64_t steady_ns) noexcept { arrival_ns_ = steady_ns; }
   // Ends the stream: the sweep in progress goes out (partial).
   void flush(SweepSink& sink);
+  // Sweeps carry point_index from now on (the evaluations; the daemon does not need it).
+  void keep_point_indices();
 
   // A new trajectory, taking effect at the next sweep's start. One offered before the
   // previous one took effect replaces it (that one is handed back by take_retired()).
@@ -148,9 +157,10 @@ class SweepProcessor {
  private:
   class FrameAdapter;
   void start_sweep(const vlp16::Frame& frame);
-  void add_points(const vlp16::Frame& frame, std::size_t first);
+  void add_points(const vlp16::Frame& frame, std::size_t first, SweepSink& sink);
   void end_sweep(const vlp16::Frame& frame, SweepSink& sink);
-  void filter_run(const vlp16::Frame& frame, std::size_t first, std::size_t end, const Eigen::Isometry3d& global_from_lidar);
+  void filter_run(const vlp16::Frame& frame, std::size_t first, std::size_t end, const Eigen::Isometry3d& global_from_lidar,
+                  SweepSink& sink);
 
   DaemonConfig config_;
   vlp16::StreamDecoder decoder_;
@@ -176,6 +186,7 @@ class SweepProcessor {
   std::vector<roi::PointXYZI> scratch_;  // one packet's points in the global frame
   roi::IndexVector kept_;
   std::int64_t arrival_ns_ = 0;
+  bool keep_indices_ = false;
   ProcessorCounters counters_;
 };
 

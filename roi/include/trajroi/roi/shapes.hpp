@@ -4,13 +4,22 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <cstdint>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "trajroi/roi/centres.hpp"
 #include "trajroi/roi/trajectory.hpp"
 
 namespace trajroi::roi {
+
+// The two ROI chain shapes of the paper, as the daemon, the evaluations and the tools name
+// them ("circular", "rectangular").
+enum class RoiShape : std::uint8_t { kCircular, kRectangular };
+[[nodiscard]] constexpr std::string_view to_string(RoiShape shape) noexcept {
+  return shape == RoiShape::kCircular ? "circular" : "rectangular";
+}
 
 // Axis-aligned box in the global XY plane (metres).
 struct Box {

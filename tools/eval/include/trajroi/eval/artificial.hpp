@@ -9,6 +9,7 @@
 #include "trajroi/roi/centres.hpp"
 #include "trajroi/roi/filter_stats.hpp"
 #include "trajroi/roi/metrics.hpp"
+#include "trajroi/roi/shapes.hpp"
 #include "trajroi/roi/point.hpp"
 #include "trajroi/roi/trajectory.hpp"
 
@@ -17,10 +18,10 @@ namespace trajroi::eval {
 // The paper's artificial-frame experiment (Section III-A, Tables 2–5), set up exactly as
 // ../shared/paper/REPRODUCTION.md reconstructs it.
 enum class ArtificialData { kStraight, kCurved };
-enum class RoiShape { kCircular, kRectangular };
+using roi::RoiShape;
 
 [[nodiscard]] std::string_view to_string(ArtificialData data) noexcept;
-[[nodiscard]] std::string_view to_string(RoiShape shape) noexcept;
+using roi::to_string;
 
 inline constexpr std::array<int, 7> kPaperRatiosPct{150, 125, 100, 75, 50, 25, 10};
 inline constexpr double kCircleDiameter_m = 6.0;

@@ -1,19 +1,25 @@
 #pragma once
 
-// The paper's evaluations on a simulated run (Tables 9, 11, 18, 19 and 20), through the real
-// pipeline: lidar.pcap decoded by the VLP-16 driver, the pose estimated from the decoded GNSS
-// and IMU recordings by the pose library, points placed in the global frame and filtered by
-// the fast ROI filters. The simulator's truth (the true pose at every firing) says where each
-// measured point really is, so pose errors show in the figures.
+// The paper's evaluations on a simulated run (Tables 9, 11, 18, 19 and 20), through the
+// daemon's own per-sweep pipeline: the run's recordings merged as trajroid merges them and fed
+// to daemon::SweepProcessor (decode, pose per firing or per sweep, transform, ROI chain placed
+// at the sweep's start from the robot's projection, exact filter), configured from the run's
+// trajroid.yaml with the scenario's evaluation sizes. The simulator's truth (the true pose at
+// every firing) says where each measured point really is, so pose errors show in the figures.
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <limits>
+#include <span>
+#include <string_view>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "trajroi/daemon/config.hpp"
+#include "trajroi/daemon/sweep_processor.hpp"
 #include "trajroi/eval/artificial.hpp"
 #include "trajroi/eval/timing.hpp"
 #include "trajroi/pose/pose_buffer.hpp"
@@ -45,6 +51,12 @@ class ScenarioRun {
   [[nodiscard]] const sim::TruthPoses& truth() const noexcept { return *truth_; }
   [[nodiscard]] const std::vector<std::uint8_t>& labels() const noexcept { return labels_; }
   [[nodiscard]] const Eigen::Isometry3d& robot_from_lidar() const noexcept { return robot_from_lidar_; }
+  // The decoder's options, as the daemon's configuration for this run sets them.
+  [[nodiscard]] vlp16::StreamOptions stream_options() const;
+  // The daemon's configuration for this run (its trajroid.yaml), with the evaluation's ROI:
+  // `shape` at `ratio_pct` % of its size along the trajectory, the scenario's look-ahead, and
+  // `mode`.
+  [[nodiscard]] daemon::DaemonConfig pipeline_config(RoiShape shape, int ratio_pct, daemon::PoseMode mode) const;
 
   // Decodes lidar.pcap and calls on_frame(frame, index of its first point in the whole run,
   // wall time spent decoding the packets since the previous frame in ms) for every frame,
@@ -61,16 +73,31 @@ class ScenarioRun {
   std::unique_ptr<sim::TruthPoses> truth_;
   std::vector<std::uint8_t> labels_;
   Eigen::Isometry3d robot_from_lidar_ = Eigen::Isometry3d::Identity();
+  daemon::DaemonConfig config_;
 };
 
-// How a frame's points get their pose: one per firing sequence (55.3 µs, motion-compensated)
-// or one for the whole frame, at its middle (the paper's way).
-enum class PoseMode { kPerFiring, kPerFrame };
+// How a sweep's points get their pose: one per firing sequence (55.3 µs, motion-compensated)
+// or one for the whole sweep, at its start (the paper's way): the daemon's pose.mode.
+using daemon::PoseMode;
+[[nodiscard]] std::string_view to_string(PoseMode mode) noexcept;
 
-// Places the frame's points in the global frame with the estimated pose. False when a pose
-// it needs is not valid (`status` says why; `out` is then incomplete).
-bool place_frame(const vlp16::Frame& frame, const pose::PoseBuffer& poses, const Eigen::Isometry3d& robot_from_lidar,
-                 PoseMode mode, std::vector<roi::PointXYZI>& out, pose::PoseStatus& status);
+// What one pass of the daemon's pipeline over the run reports.
+class PipelineObserver {
+ public:
+  virtual ~PipelineObserver() = default;
+  // Each sweep of configuration `config`, with the time the processor spent on its packets
+  // (decode, pose, transform, ROI), in ms.
+  virtual void on_sweep(std::size_t config, const daemon::Sweep& sweep, double processing_ms) = 0;
+  // Each run of points placed in the global frame (while the sweep's pose is valid).
+  virtual void on_placed(std::size_t /*config*/, const vlp16::Frame& /*frame*/, std::size_t /*first*/,
+                         std::span<const roi::PointXYZI> /*placed*/) {}
+};
+
+// One pass over the run's recordings (merged by receive time, as trajroid's replay) through one
+// daemon::SweepProcessor per configuration, sweeps carrying their point indices. Stops after
+// the sweep that ends at or after `until_ns`.
+void run_pipelines(const ScenarioRun& run, std::span<const daemon::DaemonConfig> configs, PipelineObserver& observer,
+                   std::int64_t until_ns = std::numeric_limits<std::int64_t>::max());
 
 // Where the frame's measured points really are: each placed with the true pose at its time.
 void place_frame_truth(const vlp16::Frame& frame, const sim::TruthPoses& truth,
@@ -136,15 +163,16 @@ struct KeyframeCase {
   sim::Keyframe keyframe;
   std::int64_t time_ns = 0;         // when the true robot is nearest the keyframe pose
   std::uint64_t frame_index = 0;
-  std::vector<roi::PointXYZI> points;   // global frame, estimated pose
+  std::vector<roi::PointXYZI> points;   // global frame, placed by the daemon's pipeline
   std::vector<roi::PointXYZd> truth;    // global frame, true pose
   Eigen::Isometry3d robot_pose = Eigen::Isometry3d::Identity();  // estimated, at time_ns
-  double s0_m = 0.0;                // the robot's projection on the trajectory
+  double s0_m = 0.0;                // the robot's projection on the trajectory at the sweep's start
   vlp16::Frame frame;               // as decoded (sensor frame)
 };
 
-// Finds each keyframe's frame and prepares it. Throws std::runtime_error when a keyframe is
-// not near the run's path or its pose is not valid.
+// Finds each keyframe's frame and prepares it: its points placed by the daemon's pipeline, the
+// robot's projection where the daemon placed the chain. Throws std::runtime_error when a
+// keyframe is not near the run's path or its pose is not valid.
 [[nodiscard]] std::vector<KeyframeCase> keyframe_cases(const ScenarioRun& run, PoseMode mode);
 
 struct KeyframeRow {
@@ -158,11 +186,17 @@ struct KeyframeRow {
   std::vector<std::uint8_t> truth;  // per point: in the ground-truth corridor matched to this chain
 };
 
-// One row: the chain from the robot's projection over the look-ahead, spacing ratio × size;
-// ground truth: the corridor of the ROI's width from the chain's first to its last centre,
-// with round ends (circles) or extended by a/2 with square ends (rectangles), so only the
-// middle of the chains is compared (the paper's matching of the ends). Timed `reps` times:
-// transform with the pose, centres, ROI set, grid and filter.
+// The rows of every case × shape × ratio (in that nesting: row (s, c, r) is at
+// (s · cases + c) · ratios + r): the daemon's pipeline with that shape and spacing ratio,
+// kept points and chain of the keyframe's sweep; ground truth: the corridor of the ROI's width
+// from the chain's first to its last centre, with round ends (circles) or extended by a/2 with
+// square ends (rectangles), so only the middle of the chains is compared (the paper's matching
+// of the ends). Time: the processor's time on the sweep's packets (decode, pose, transform,
+// chain, grid and filter) over `reps` passes of the run.
+[[nodiscard]] std::vector<KeyframeRow> run_keyframe_rows(const ScenarioRun& run, const std::vector<KeyframeCase>& cases,
+                                                         std::span<const RoiShape> shapes, std::span<const int> ratios_pct,
+                                                         int reps, PoseMode mode);
+// One row (one pass per repetition).
 [[nodiscard]] KeyframeRow run_keyframe_row(const ScenarioRun& run, const KeyframeCase& c, RoiShape shape,
                                            int ratio_pct, int reps, PoseMode mode);
 
@@ -186,8 +220,8 @@ struct SequentialReport {
   std::vector<FrameTiming> per_frame;
 };
 
-// Every complete frame through decode → place → ROI (both shapes, 25 %), the decode of each
-// frame's packets included in both shapes' times.
+// Every complete sweep through the daemon's pipeline (both shapes, 25 %): the processor's time
+// on its packets (decode included).
 [[nodiscard]] SequentialReport run_sequential(const ScenarioRun& run, PoseMode mode, int ratio_pct = 25);
 
 // ---- Table 19: accumulated frames -----------------------------------------------------------
@@ -215,9 +249,9 @@ struct AccumulatedReport {
   std::vector<std::pair<double, double>> circular_samples, rectangular_samples;
 };
 
-// Consecutive complete frames placed in the global frame and joined N at a time; each cloud
-// filtered once per shape (centres from the robot's projection at its last frame; time:
-// centres, ROI set, grid and filter) at 25 %.
+// Consecutive complete sweeps placed in the global frame by the daemon's pipeline and joined N
+// at a time; each cloud filtered once per shape (centres from the daemon's projection at its
+// last sweep's start; time: centres, ROI set, grid and filter) at 25 %.
 [[nodiscard]] AccumulatedReport run_accumulated(const ScenarioRun& run, PoseMode mode, int ratio_pct = 25);
 
 [[nodiscard]] LinearFit fit_line(const std::vector<std::pair<double, double>>& samples_points_ms);
