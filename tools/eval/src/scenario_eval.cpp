@@ -393,13 +393,14 @@ SequentialReport run_sequential(const ScenarioRun& run, PoseMode mode, int ratio
   struct Collect final : PipelineObserver {
     SequentialReport report;
     std::map<std::uint64_t, FrameTiming> frames;  // complete sweeps with a valid pose, by index
+    std::map<std::uint64_t, std::int64_t> starts;  // every complete sweep's start (the data cycle)
     std::size_t n_circ = 0, n_rect = 0;
-    double points_sum = 0.0;
     void on_sweep(std::size_t k, const daemon::Sweep& sweep, double ms) override {
       if (sweep.partial) {
         if (k == 0) ++report.skipped_partial;
         return;
       }
+      if (k == 0) starts[sweep.index] = sweep.start_ns;
       if (!sweep.filtered) {
         if (k == 0) ++report.skipped_no_pose;
         return;
@@ -407,7 +408,6 @@ SequentialReport run_sequential(const ScenarioRun& run, PoseMode mode, int ratio
       FrameTiming& f = frames[sweep.index];
       f.frame_index = sweep.index;
       f.points = sweep.points_in;
-      f.start_s = static_cast<double>(sweep.start_ns) * 1e-9;  // made relative below
       if (k == 0) {
         f.circular_ms = ms;
         add_sample(report.circular, n_circ, ms);
@@ -419,22 +419,23 @@ SequentialReport run_sequential(const ScenarioRun& run, PoseMode mode, int ratio
   } collect;
   run_pipelines(run, configs, collect);
   SequentialReport report = std::move(collect.report);
+  // The cycle between consecutive complete sweeps, with or without a pose.
   std::size_t n_cycle = 0;
-  double points_sum = 0.0;
-  double first_start_s = 0.0, previous_start_s = 0.0;
+  std::map<std::uint64_t, double> cycle_ms;
+  const std::int64_t first_start = collect.starts.empty() ? 0 : collect.starts.begin()->second;
+  std::int64_t previous = 0;
   bool first = true;
-  for (auto& [index, f] : collect.frames) {
-    const double start_s = f.start_s;
-    if (first) {
-      first_start_s = start_s;
-      f.cycle_ms = 0.0;
-    } else {
-      f.cycle_ms = (start_s - previous_start_s) * 1e3;
-      add_sample(report.cycle, n_cycle, f.cycle_ms);
-    }
+  for (const auto& [index, start] : collect.starts) {
+    const double ms = first ? 0.0 : static_cast<double>(start - previous) * 1e-6;
+    if (!first) add_sample(report.cycle, n_cycle, ms);
+    cycle_ms[index] = ms;
     first = false;
-    previous_start_s = start_s;
-    f.start_s = start_s - first_start_s;
+    previous = start;
+  }
+  double points_sum = 0.0;
+  for (auto& [index, f] : collect.frames) {
+    f.cycle_ms = cycle_ms[index];
+    f.start_s = static_cast<double>(collect.starts[index] - first_start) * 1e-9;
     points_sum += static_cast<double>(f.points);
     report.per_frame.push_back(f);
   }
