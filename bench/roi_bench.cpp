@@ -47,8 +47,7 @@ roi::SimdPath simd_path() {
     if (wanted == "sse2") return roi::SimdPath::kSse2;
     if (wanted == "scalar") return roi::SimdPath::kScalar;
     if (!wanted.empty() && wanted != "auto") {
-      std::fprintf(stderr, "roi_bench: TRAJROI_SIMD=%s is not auto, avx512, avx2, sse2 or scalar\n",
-                   wanted.c_str());
+      std::fprintf(stderr, "roi_bench: TRAJROI_SIMD=%s is not auto, avx512, avx2, sse2 or scalar\n", wanted.c_str());
       std::exit(2);
     }
     return roi::SimdPath::kAuto;
@@ -125,7 +124,8 @@ void limit_read(benchmark::State& state, bool accumulated) {
   const auto& points = cloud(accumulated);
   for (auto _ : state) {
     float sum = 0.0f;
-    for (const roi::PointXYZI& p : points) sum += p.x + p.y + p.z;
+    for (const roi::PointXYZI& p : points)
+      sum += p.x + p.y + p.z;
     benchmark::DoNotOptimize(sum);
   }
   set_counters(state, points.size(), 0, 0);
@@ -150,13 +150,17 @@ int register_all() {
     for (const int ratio : {25, 10}) {
       const std::string r = std::to_string(ratio);
       benchmark::RegisterBenchmark(("roi/circular/reference/" + where + "/" + r).c_str(),
-                                   reference<roi::CircularRoiSet>, accumulated, ratio)->Unit(unit);
-      benchmark::RegisterBenchmark(("roi/circular/fast/" + where + "/" + r).c_str(),
-                                   fast<roi::CircularRoiSet>, accumulated, ratio)->Unit(unit);
+                                   reference<roi::CircularRoiSet>, accumulated, ratio)
+          ->Unit(unit);
+      benchmark::RegisterBenchmark(("roi/circular/fast/" + where + "/" + r).c_str(), fast<roi::CircularRoiSet>,
+                                   accumulated, ratio)
+          ->Unit(unit);
       benchmark::RegisterBenchmark(("roi/rectangular/reference/" + where + "/" + r).c_str(),
-                                   reference<roi::RectangularRoiSet>, accumulated, ratio)->Unit(unit);
-      benchmark::RegisterBenchmark(("roi/rectangular/fast/" + where + "/" + r).c_str(),
-                                   fast<roi::RectangularRoiSet>, accumulated, ratio)->Unit(unit);
+                                   reference<roi::RectangularRoiSet>, accumulated, ratio)
+          ->Unit(unit);
+      benchmark::RegisterBenchmark(("roi/rectangular/fast/" + where + "/" + r).c_str(), fast<roi::RectangularRoiSet>,
+                                   accumulated, ratio)
+          ->Unit(unit);
     }
     benchmark::RegisterBenchmark(("limit/read/" + where).c_str(), limit_read, accumulated)->Unit(unit);
     benchmark::RegisterBenchmark(("limit/memcpy/" + where).c_str(), limit_memcpy, accumulated)->Unit(unit);

@@ -79,8 +79,12 @@ void BM_Vn100(benchmark::State& state, const char* file) {
 }
 
 BENCHMARK_CAPTURE(BM_Ubx, glo, "ublox/gpsd/ublox-glo.log")->Name("ubx/glo (169 kB)")->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_Ubx, f9r, "ublox/gpsd/ublox-zed-f9r.log")->Name("ubx/zed-f9r (158 kB, NMEA+RTCM3 mixed)")->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_Vn100, f00379, "vectornav/LoggerWavesInIce_F00379.raw")->Name("vn100/F00379 raw (1.4 MB)")->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Ubx, f9r, "ublox/gpsd/ublox-zed-f9r.log")
+    ->Name("ubx/zed-f9r (158 kB, NMEA+RTCM3 mixed)")
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Vn100, f00379, "vectornav/LoggerWavesInIce_F00379.raw")
+    ->Name("vn100/F00379 raw (1.4 MB)")
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

@@ -45,8 +45,7 @@ inline std::vector<roi::PointXYZI> synthetic_frame() {
         }
       }
       if (std::abs(cx) > 1e-9) range = std::min(range, kEndWall_m / (std::abs(cx) * horizontal));
-      frame.push_back({static_cast<float>(range * horizontal * cx),
-                       static_cast<float>(range * horizontal * sy),
+      frame.push_back({static_cast<float>(range * horizontal * cx), static_cast<float>(range * horizontal * sy),
                        static_cast<float>(range * std::sin(el)), static_cast<float>(ring)});
     }
   }
@@ -71,8 +70,9 @@ inline std::vector<roi::PointXYZI> accumulated_cloud(int frames) {
   std::vector<roi::PointXYZI> cloud(frame.size() * static_cast<std::size_t>(frames));
   for (int k = 0; k < frames; ++k) {
     const Eigen::Isometry3d global_from_robot = roi::pose_from_xy_yaw(0.05 * k, 0.0, 0.0);
-    roi::transform_points(global_from_robot * robot_from_sensor, frame,
-                          std::span<roi::PointXYZI>(cloud).subspan(frame.size() * static_cast<std::size_t>(k), frame.size()));
+    roi::transform_points(
+        global_from_robot * robot_from_sensor, frame,
+        std::span<roi::PointXYZI>(cloud).subspan(frame.size() * static_cast<std::size_t>(k), frame.size()));
   }
   return cloud;
 }

@@ -48,13 +48,15 @@ void BM_DecodePackets(benchmark::State& state) {
   std::size_t decoded = 0;
   for (auto _ : state) {
     points.clear();
-    for (const auto& packet : capture.packets) decoded += decoder.decode(packet, points).points;
+    for (const auto& packet : capture.packets)
+      decoded += decoder.decode(packet, points).points;
     benchmark::DoNotOptimize(points.data());
     benchmark::ClobberMemory();
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(decoded));
-  state.counters["packets/s"] = benchmark::Counter(
-      static_cast<double>(capture.packets.size()) * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["packets/s"] =
+      benchmark::Counter(static_cast<double>(capture.packets.size()) * static_cast<double>(state.iterations()),
+                         benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_DecodePackets)->Name("vlp16/decode/mrpt")->Unit(benchmark::kMicrosecond);
 
@@ -72,7 +74,8 @@ void BM_StreamDecoder(benchmark::State& state) {
     StreamDecoder decoder(Calibration::vlp16_default(), {});
     CountingSink sink;
     state.ResumeTiming();
-    for (std::size_t i = 0; i < capture.packets.size(); ++i) decoder.on_data_packet(capture.packets[i], capture.times[i], sink);
+    for (std::size_t i = 0; i < capture.packets.size(); ++i)
+      decoder.on_data_packet(capture.packets[i], capture.times[i], sink);
     decoder.flush(sink);
     decoded += sink.points;
   }

@@ -13,8 +13,8 @@ packages=(
   liblcm-dev liblcm-bin liblcm-java libjchart2d-java default-jdk-headless
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
-  # fuzzing and sanitizers (clang's libFuzzer and runtimes)
-  clang libclang-rt-14-dev
+  # fuzzing and sanitizers (clang's libFuzzer and runtimes); the clang build and the format check
+  clang libclang-rt-14-dev clang-format
   # systemd-analyze for the unit checks
   systemd
 )

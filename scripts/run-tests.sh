@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# The README's test command: installs every dependency, builds with warnings as errors, and
-# runs, each through ctest:
+# The README's test command: installs every dependency, checks the formatting (the committed
+# .clang-format), builds with warnings as errors with GCC and with clang (tests and benchmarks
+# included; the clang build is compiled, its tests are the GCC release's), and runs, each
+# through ctest:
 #   1. the whole suite, release build;
 #   2. the whole suite under AddressSanitizer + UndefinedBehaviorSanitizer (preset asan);
 #   3. the threaded tests — the lock-free ring, the daemon end to end and its control — under
@@ -13,6 +15,11 @@ cd "$(dirname "$0")/.."
 jobs=$(nproc)
 
 bash scripts/install-deps.sh
+
+bash scripts/check-format.sh
+
+cmake --preset clang
+cmake --build --preset clang -j"$jobs"
 
 cmake --preset release
 cmake --build --preset release -j"$jobs"

@@ -1,8 +1,5 @@
 #include "trajroi/daemon/config.hpp"
 
-#include "trajroi/config/origin.hpp"
-#include "trajroi/config/text_file.hpp"
-
 #include <arpa/inet.h>
 
 #include <cmath>
@@ -11,6 +8,8 @@
 #include <numbers>
 #include <sstream>
 
+#include "trajroi/config/origin.hpp"
+#include "trajroi/config/text_file.hpp"
 #include "trajroi/roi/transform.hpp"
 
 namespace trajroi::daemon {

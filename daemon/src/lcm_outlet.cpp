@@ -1,5 +1,4 @@
 #include <lcm/lcm-cpp.hpp>
-
 #include <stdexcept>
 
 #include "outlet.hpp"
@@ -24,12 +23,17 @@ void LcmOutlet::subscribe(const std::string& channel, Handler handler) {
   transport::subscribe_raw<&LcmOutlet::on_message>(*lcm_, channel, this);
 }
 
-int LcmOutlet::incoming_fd() const noexcept { return lcm_->getFileno(); }
+int LcmOutlet::incoming_fd() const noexcept {
+  return lcm_->getFileno();
+}
 
-void LcmOutlet::handle_incoming() { (void)lcm_->handleTimeout(0); }
+void LcmOutlet::handle_incoming() {
+  (void)lcm_->handleTimeout(0);
+}
 
 void LcmOutlet::on_message(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
-  if (handler_) handler_(std::span<const std::uint8_t>(static_cast<const std::uint8_t*>(buffer->data), buffer->data_size), channel);
+  if (handler_)
+    handler_(std::span<const std::uint8_t>(static_cast<const std::uint8_t*>(buffer->data), buffer->data_size), channel);
 }
 
 }  // namespace trajroi::daemon

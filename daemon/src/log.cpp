@@ -18,7 +18,9 @@ void init(const std::string& level) {
   set_level(level);
 }
 
-void set_level(const std::string& level) { spdlog::set_level(spdlog::level::from_str(level)); }
+void set_level(const std::string& level) {
+  spdlog::set_level(spdlog::level::from_str(level));
+}
 
 bool RateLimited::allow(std::int64_t now_ns, std::uint64_t& suppressed) noexcept {
   std::int64_t next = next_ns_.load(std::memory_order_relaxed);

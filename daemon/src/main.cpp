@@ -1,6 +1,5 @@
 // trajroid — the trajectory-ROI daemon. See daemon/README.md and config/trajroid.yaml.
 #include <CLI/CLI.hpp>
-
 #include <cstdio>
 #include <exception>
 #include <memory>
@@ -19,7 +18,8 @@ int main(int argc, char** argv) {
   bool check_config = false, loop = false;
   app.add_option("--config", config_file, "YAML configuration (see config/trajroid.yaml)")->required();
   app.add_option("--replay", replay, "Replay a run folder (lidar.pcap, gnss.trjb, imu.trjb) instead of the sensors");
-  app.add_option("--rate", rate, "Replay pace: realtime, max, or a factor of real time (e.g. 10)")->capture_default_str();
+  app.add_option("--rate", rate, "Replay pace: realtime, max, or a factor of real time (e.g. 10)")
+      ->capture_default_str();
   app.add_flag("--loop", loop, "With --replay: play the run again and again (times shifted each lap) until stopped");
   app.add_option("--record", record, "Record every raw input with its host receive time into this folder");
   app.add_option("--lcm-url", lcm_url, "LCM provider URL (overrides lcm.url)");

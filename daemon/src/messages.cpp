@@ -14,7 +14,8 @@ void copy_into(std::vector<T>& out, const std::vector<T>& in) {
 }
 
 void set_pose(const PublishedPose& p, double (&position)[3], double (&orientation)[4]) {
-  for (int i = 0; i < 3; ++i) position[i] = p.position_m[i];
+  for (int i = 0; i < 3; ++i)
+    position[i] = p.position_m[i];
   orientation[0] = p.orientation.w();
   orientation[1] = p.orientation.x();
   orientation[2] = p.orientation.y();
@@ -84,14 +85,22 @@ void fill_roi(const Sweep& sweep, trajroi::roi_t& out) {
 
 std::string_view to_string(TrajectoryReject reason) noexcept {
   switch (reason) {
-    case TrajectoryReject::kNone: return "accepted";
-    case TrajectoryReject::kBadId: return "id not positive";
-    case TrajectoryReject::kBadCoordinates: return "unknown coordinates";
-    case TrajectoryReject::kTooFewWaypoints: return "fewer than 2 distinct waypoints";
-    case TrajectoryReject::kTooManyWaypoints: return "too many waypoints";
-    case TrajectoryReject::kNonFinite: return "non-finite waypoint";
-    case TrajectoryReject::kOutOfRange: return "latitude/longitude out of range";
-    case TrajectoryReject::kUndecodable: return "undecodable message";
+    case TrajectoryReject::kNone:
+      return "accepted";
+    case TrajectoryReject::kBadId:
+      return "id not positive";
+    case TrajectoryReject::kBadCoordinates:
+      return "unknown coordinates";
+    case TrajectoryReject::kTooFewWaypoints:
+      return "fewer than 2 distinct waypoints";
+    case TrajectoryReject::kTooManyWaypoints:
+      return "too many waypoints";
+    case TrajectoryReject::kNonFinite:
+      return "non-finite waypoint";
+    case TrajectoryReject::kOutOfRange:
+      return "latitude/longitude out of range";
+    case TrajectoryReject::kUndecodable:
+      return "undecodable message";
   }
   return "unknown";
 }
@@ -107,7 +116,8 @@ TrajectoryCheck check_trajectory(const trajroi::trajectory_t& m, const pose::Glo
   if (m.coordinates != trajroi::trajectory_t::GLOBAL_XY && m.coordinates != trajroi::trajectory_t::LAT_LON) {
     return reject(TrajectoryReject::kBadCoordinates, "coordinates " + std::to_string(m.coordinates));
   }
-  if (m.num_waypoints < 2) return reject(TrajectoryReject::kTooFewWaypoints, std::to_string(m.num_waypoints) + " waypoints");
+  if (m.num_waypoints < 2)
+    return reject(TrajectoryReject::kTooFewWaypoints, std::to_string(m.num_waypoints) + " waypoints");
   if (m.num_waypoints > kMaxMessageWaypoints) {
     return reject(TrajectoryReject::kTooManyWaypoints, std::to_string(m.num_waypoints) + " waypoints");
   }

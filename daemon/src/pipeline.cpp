@@ -6,16 +6,15 @@
 
 namespace trajroi::daemon {
 
-namespace {
-std::int64_t clock_ns(clockid_t clock) noexcept {
+std::int64_t steady_ns() noexcept {
+  return inputs::monotonic_ns();
+}
+
+std::int64_t thread_cpu_ns() noexcept {
   timespec ts{};
-  clock_gettime(clock, &ts);
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
-}  // namespace
-
-std::int64_t steady_ns() noexcept { return clock_ns(CLOCK_MONOTONIC); }
-std::int64_t thread_cpu_ns() noexcept { return clock_ns(CLOCK_THREAD_CPUTIME_ID); }
 
 Pipeline::Pipeline(const DaemonConfig& config_in, bool exact_in, bool recording)
     : config(config_in),

@@ -112,8 +112,8 @@ struct Pipeline {
   std::vector<std::unique_ptr<InputLane>> inputs;
   Ring<Sweep> sweeps;
   std::unique_ptr<Ring<StatusSnapshot>> status;
-  Ring<TrajectoryItem> trajectories_in;   // publisher → processing
-  Ring<TrajectoryItem> trajectories_out;  // processing → publisher (to free)
+  Ring<TrajectoryItem> trajectories_in;     // publisher → processing
+  Ring<TrajectoryItem> trajectories_out;    // processing → publisher (to free)
   std::unique_ptr<Ring<InputSlot>> record;  // processing → recorder, when recording
   std::atomic<bool> processing_done{false}, publishing_done{false};
   std::atomic<std::uint64_t> processing_beat{0}, publishing_beat{0};

@@ -31,8 +31,8 @@ class RingSink final : public SweepSink {
       std::this_thread::sleep_for(std::chrono::microseconds(20));
     };
     // An as-fast-as-possible replay waits for the publisher (exact output); live drops.
-    const bool pushed = pipeline_.exact ? pipeline_.sweeps.push_wait(fill, pipeline_.stop, on_full)
-                                        : pipeline_.sweeps.try_push(fill);
+    const bool pushed =
+        pipeline_.exact ? pipeline_.sweeps.push_wait(fill, pipeline_.stop, on_full) : pipeline_.sweeps.try_push(fill);
     if (pushed) pipeline_.publish_wake.notify();
     accumulated_ns_ = 0;
     packet_start_ns_ = now;
@@ -48,7 +48,8 @@ class RingSink final : public SweepSink {
 
 class Processing {
  public:
-  Processing(Pipeline& pipeline, SweepProcessor& processor) : pipeline_(pipeline), processor_(processor), sink_(pipeline) {}
+  Processing(Pipeline& pipeline, SweepProcessor& processor)
+      : pipeline_(pipeline), processor_(processor), sink_(pipeline) {}
 
   // The lane whose front item (`front`) is oldest in the global order, or null when all are empty.
   InputLane* oldest(InputSlot*& front) noexcept {
@@ -79,8 +80,12 @@ class Processing {
         sink_.packet_done(steady_ns());
         break;
       }
-      case inputs::Stream::kGnss: processor_.gnss_bytes(bytes, item.receive_ns); break;
-      case inputs::Stream::kImu: processor_.imu_bytes(bytes, item.receive_ns); break;
+      case inputs::Stream::kGnss:
+        processor_.gnss_bytes(bytes, item.receive_ns);
+        break;
+      case inputs::Stream::kImu:
+        processor_.imu_bytes(bytes, item.receive_ns);
+        break;
     }
     if (pipeline_.record) {
       const auto on_full = [this] {
@@ -102,7 +107,8 @@ class Processing {
     }
     if (auto retired = processor_.take_retired()) {
       // A full ring (the publisher has not collected 8 of them) frees it here, once.
-      (void)pipeline_.trajectories_out.try_push([&retired](TrajectoryItem& slot) { slot.trajectory = std::move(retired); });
+      (void)pipeline_.trajectories_out.try_push(
+          [&retired](TrajectoryItem& slot) { slot.trajectory = std::move(retired); });
     }
   }
 
@@ -120,7 +126,8 @@ class Processing {
     for (;;) {
       if (steady_ns() >= stall_at) {
         log::warn("fault injection: the processing thread stops making progress");
-        while (!pipeline_.stop.load(std::memory_order_relaxed)) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        while (!pipeline_.stop.load(std::memory_order_relaxed))
+          std::this_thread::sleep_for(std::chrono::milliseconds(50));
         break;
       }
       pipeline_.processing_beat.fetch_add(1, std::memory_order_relaxed);

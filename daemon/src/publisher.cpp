@@ -64,8 +64,8 @@ void Publisher::send(const std::string& channel, const Message& m) {
 }
 
 void Publisher::offer(std::unique_ptr<ActiveTrajectory> trajectory) {
-  const bool pushed =
-      pipeline_.trajectories_in.try_push([&trajectory](TrajectoryItem& slot) { slot.trajectory = std::move(trajectory); });
+  const bool pushed = pipeline_.trajectories_in.try_push(
+      [&trajectory](TrajectoryItem& slot) { slot.trajectory = std::move(trajectory); });
   if (pushed) pipeline_.process_wake.notify();
 }
 
@@ -148,7 +148,8 @@ void Publisher::publish_status(const StatusSnapshot& s) {
     m.counter_names.push_back(std::move(name));
     m.counter_values.push_back(static_cast<std::int64_t>(value));
   };
-  for (std::size_t i = 0; i < kCounterCount; ++i) add(std::string(counter_name(i)), s.counters[i]);
+  for (std::size_t i = 0; i < kCounterCount; ++i)
+    add(std::string(counter_name(i)), s.counters[i]);
   for (std::size_t i = 1; i < kTrajectoryRejectCount; ++i) {
     add("trajectory.rejected: " + std::string(to_string(static_cast<TrajectoryReject>(i))), trajectory_rejects_[i]);
   }
@@ -160,11 +161,12 @@ void Publisher::publish_status(const StatusSnapshot& s) {
 
   const double kept_pct =
       m.points_in > 0 ? 100.0 * static_cast<double>(m.points_kept) / static_cast<double>(m.points_in) : 0.0;
-  log::info("status: sweeps {} published {} withheld {} | points in {} kept {} ({:.1f} %) | latency p50 {:.2f} p99 "
-            "{:.2f} ms | drops {} | lost packets {} | pose {} (fix {}, age {:.2f} s) | trajectory {}",
-            m.sweeps, m.sweeps_published, m.sweeps_without_pose, m.points_in, m.points_kept, kept_pct,
-            m.latency_ms_p50, m.latency_ms_p99, m.ring_drops, m.lost_packets, m.pose_status,
-            static_cast<int>(m.fix_type), m.pose_age_s, m.trajectory_id);
+  log::info(
+      "status: sweeps {} published {} withheld {} | points in {} kept {} ({:.1f} %) | latency p50 {:.2f} p99 "
+      "{:.2f} ms | drops {} | lost packets {} | pose {} (fix {}, age {:.2f} s) | trajectory {}",
+      m.sweeps, m.sweeps_published, m.sweeps_without_pose, m.points_in, m.points_kept, kept_pct, m.latency_ms_p50,
+      m.latency_ms_p99, m.ring_drops, m.lost_packets, m.pose_status, static_cast<int>(m.fix_type), m.pose_age_s,
+      m.trajectory_id);
   latency_window_ms_.clear();
   processing_window_ms_.clear();
   last_status_ = s;
@@ -174,15 +176,16 @@ void Publisher::publish_status(const StatusSnapshot& s) {
 
 // Once a minute, for the journal and soak tests: what the last minute did, and the memory.
 void Publisher::log_minute(const StatusSnapshot& s) {
-  log::info("minute: {:.0f} s | sweeps {} published {} | latency p50 {:.2f} p99 {:.2f} max {:.2f} ms | ring drops {} | "
-            "kernel drops {} | lost packets {} | RSS {:.1f} MiB",
-            static_cast<double>(s.steady_ns - minute_start_.steady_ns) * 1e-9,
-            s.processor.sweeps - minute_start_.processor.sweeps,
-            s.processor.sweeps_filtered - minute_start_.processor.sweeps_filtered, percentile(latency_minute_ms_, 0.50),
-            percentile(latency_minute_ms_, 0.99), percentile(latency_minute_ms_, 1.0),
-            s.ring_drops() - minute_start_.ring_drops(),
-            s[Counter::kLidarKernelDrops] - minute_start_[Counter::kLidarKernelDrops],
-            s.lost_packets - minute_start_.lost_packets, rss_mib());
+  log::info(
+      "minute: {:.0f} s | sweeps {} published {} | latency p50 {:.2f} p99 {:.2f} max {:.2f} ms | ring drops {} | "
+      "kernel drops {} | lost packets {} | RSS {:.1f} MiB",
+      static_cast<double>(s.steady_ns - minute_start_.steady_ns) * 1e-9,
+      s.processor.sweeps - minute_start_.processor.sweeps,
+      s.processor.sweeps_filtered - minute_start_.processor.sweeps_filtered, percentile(latency_minute_ms_, 0.50),
+      percentile(latency_minute_ms_, 0.99), percentile(latency_minute_ms_, 1.0),
+      s.ring_drops() - minute_start_.ring_drops(),
+      s[Counter::kLidarKernelDrops] - minute_start_[Counter::kLidarKernelDrops],
+      s.lost_packets - minute_start_.lost_packets, rss_mib());
   latency_minute_ms_.clear();
   minute_start_ = s;
 }
@@ -192,10 +195,9 @@ void Publisher::run() {
     log::warn("{}", w);
   }
   const std::int64_t cpu_start = thread_cpu_ns();
-  outlet_.subscribe(config_.lcm.trajectory,
-                    [this](std::span<const std::uint8_t> bytes, const std::string& channel) {
-                      on_trajectory_message(bytes, channel);
-                    });
+  outlet_.subscribe(config_.lcm.trajectory, [this](std::span<const std::uint8_t> bytes, const std::string& channel) {
+    on_trajectory_message(bytes, channel);
+  });
   latency_window_ms_.reserve(4096);
   processing_window_ms_.reserve(4096);
   latency_minute_ms_.reserve(1U << 16);

@@ -1,8 +1,8 @@
 #include "realtime.hpp"
 
+#include <alloca.h>
 #include <pthread.h>
 #include <sched.h>
-#include <alloca.h>
 #include <sys/mman.h>
 
 #include <cerrno>
@@ -16,7 +16,8 @@ std::string apply_thread_config(const char* name, const ThreadConfig& config) {
   if (!config.cpus.empty()) {
     cpu_set_t set;
     CPU_ZERO(&set);
-    for (const int cpu : config.cpus) CPU_SET(static_cast<std::size_t>(cpu), &set);
+    for (const int cpu : config.cpus)
+      CPU_SET(static_cast<std::size_t>(cpu), &set);
     if (const int rc = pthread_setaffinity_np(pthread_self(), sizeof set, &set); rc != 0) {
       warning += std::string("thread ") + name + ": CPU affinity not set (" + std::strerror(rc) + "); ";
     }
@@ -44,7 +45,8 @@ std::string lock_memory() {
 
 void prefault_stack(std::size_t bytes) {
   auto* volatile stack = static_cast<volatile unsigned char*>(alloca(bytes));
-  for (std::size_t i = 0; i < bytes; i += 4096) stack[i] = 0;
+  for (std::size_t i = 0; i < bytes; i += 4096)
+    stack[i] = 0;
 }
 
 }  // namespace trajroi::daemon

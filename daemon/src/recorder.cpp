@@ -20,10 +20,18 @@ void record_to(Pipeline& pipeline, const std::filesystem::path& dir) {
     while (InputSlot* s = ring.front()) {
       const std::span<const std::uint8_t> bytes(s->bytes.data(), s->size);
       switch (s->stream) {
-        case inputs::Stream::kLidarData: pcap.write(s->receive_ns, vlp16::kDataPort, bytes); break;
-        case inputs::Stream::kLidarPosition: pcap.write(s->receive_ns, vlp16::kPositionPort, bytes); break;
-        case inputs::Stream::kGnss: gnss.write(serial::Chunk{bytes, s->receive_ns}); break;
-        case inputs::Stream::kImu: imu.write(serial::Chunk{bytes, s->receive_ns}); break;
+        case inputs::Stream::kLidarData:
+          pcap.write(s->receive_ns, vlp16::kDataPort, bytes);
+          break;
+        case inputs::Stream::kLidarPosition:
+          pcap.write(s->receive_ns, vlp16::kPositionPort, bytes);
+          break;
+        case inputs::Stream::kGnss:
+          gnss.write(serial::Chunk{bytes, s->receive_ns});
+          break;
+        case inputs::Stream::kImu:
+          imu.write(serial::Chunk{bytes, s->receive_ns});
+          break;
       }
       ring.release();
       any = true;

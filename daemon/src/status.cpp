@@ -9,7 +9,9 @@ namespace {
 
 using C = Counter;
 
-constexpr std::size_t at(Counter c) { return static_cast<std::size_t>(c); }
+constexpr std::size_t at(Counter c) {
+  return static_cast<std::size_t>(c);
+}
 
 // Names, built once: the decoders' enums give the names of their blocks.
 struct Names {
@@ -28,7 +30,8 @@ struct Names {
     set(C::kLidarRejectedSource, "lidar.rejected_source");
     set(C::kLidarKernelDrops, "lidar.kernel_drops");
     for (std::size_t e = 1; e < vlp16::kPacketErrorCount; ++e) {
-      name[at(C::kLidarRejected) + e - 1] = "lidar.rejected." + std::string(vlp16::to_string(static_cast<vlp16::PacketError>(e)));
+      name[at(C::kLidarRejected) + e - 1] =
+          "lidar.rejected." + std::string(vlp16::to_string(static_cast<vlp16::PacketError>(e)));
     }
     set(C::kLidarOutOfOrder, "lidar.out_of_order");
     set(C::kLidarRestarts, "lidar.restarts");
@@ -81,7 +84,8 @@ std::string_view counter_name(std::size_t index) noexcept {
 
 std::uint64_t StatusSnapshot::ring_drops() const noexcept {
   std::uint64_t drops = 0;
-  for (std::size_t c = at(C::kRingDropsLidar); c <= at(C::kRingDropsRecord); ++c) drops += counters[c];
+  for (std::size_t c = at(C::kRingDropsLidar); c <= at(C::kRingDropsRecord); ++c)
+    drops += counters[c];
   return drops;
 }
 
@@ -123,7 +127,8 @@ void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64
   s[C::kRingDropsStatus] = pipeline.status->dropped();
   s[C::kRingDropsTrajectory] = pipeline.trajectories_in.dropped();
   s[C::kRingDropsRecord] = pipeline.record ? pipeline.record->dropped() : 0;
-  for (std::size_t e = 1; e < vlp16::kPacketErrorCount; ++e) s.counters[at(C::kLidarRejected) + e - 1] = l.rejected[e];
+  for (std::size_t e = 1; e < vlp16::kPacketErrorCount; ++e)
+    s.counters[at(C::kLidarRejected) + e - 1] = l.rejected[e];
   s[C::kLidarOutOfOrder] = l.out_of_order;
   s[C::kLidarRestarts] = l.restarts;
   s[C::kLidarLateDropped] = l.late_dropped;
@@ -133,7 +138,8 @@ void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64
   s[C::kLidarOutOfRange] = l.out_of_range;
   s[C::kLidarPartialSweeps] = l.partial_frames;
   s[C::kLidarPositionWrongSize] = l.position_wrong_size;
-  for (std::size_t e = 1; e < vlp16::kNmeaErrorCount; ++e) s.counters[at(C::kLidarNmea) + e - 1] = l.nmea[e];
+  for (std::size_t e = 1; e < vlp16::kNmeaErrorCount; ++e)
+    s.counters[at(C::kLidarNmea) + e - 1] = l.nmea[e];
   const pose_input::PoseInput& in = p.pose_input();
   const auto framing = [&s](Counter first, const framing::FramerCounters& f) {
     s.counters[at(first)] = f.bytes;

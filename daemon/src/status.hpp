@@ -7,10 +7,10 @@
 #include <cstdint>
 #include <string_view>
 
-#include "trajroi/pose/pose_buffer.hpp"
-#include "trajroi/vlp16/position.hpp"
-#include "trajroi/vlp16/packet.hpp"
 #include "trajroi/daemon/sweep_processor.hpp"
+#include "trajroi/pose/pose_buffer.hpp"
+#include "trajroi/vlp16/packet.hpp"
+#include "trajroi/vlp16/position.hpp"
 
 namespace trajroi::daemon {
 
@@ -18,21 +18,51 @@ struct Pipeline;
 
 // Ranges of the decoders' own error enums sit in the table as blocks (their kNone omitted).
 enum class Counter : std::uint16_t {
-  kRingDropsLidar, kRingDropsGnss, kRingDropsImu, kRingDropsSweeps, kRingDropsStatus, kRingDropsTrajectory,
+  kRingDropsLidar,
+  kRingDropsGnss,
+  kRingDropsImu,
+  kRingDropsSweeps,
+  kRingDropsStatus,
+  kRingDropsTrajectory,
   kRingDropsRecord,
-  kLidarOversize, kLidarSourceErrors, kLidarRejectedSource, kLidarKernelDrops,
+  kLidarOversize,
+  kLidarSourceErrors,
+  kLidarRejectedSource,
+  kLidarKernelDrops,
   kLidarRejected,  // + PacketError − 1
   kLidarOutOfOrder = kLidarRejected + vlp16::kPacketErrorCount - 1,
-  kLidarRestarts, kLidarLateDropped, kLidarDuplicates, kLidarClockResets, kLidarNoReturn, kLidarOutOfRange,
-  kLidarPartialSweeps, kLidarPositionWrongSize,
+  kLidarRestarts,
+  kLidarLateDropped,
+  kLidarDuplicates,
+  kLidarClockResets,
+  kLidarNoReturn,
+  kLidarOutOfRange,
+  kLidarPartialSweeps,
+  kLidarPositionWrongSize,
   kLidarNmea,  // + NmeaError − 1
   kGnssBytes = kLidarNmea + vlp16::kNmeaErrorCount - 1,
-  kGnssFrames, kGnssSkippedBytes, kGnssChecksumErrors, kGnssBadLengths,
-  kImuBytes, kImuFrames, kImuSkippedBytes, kImuChecksumErrors, kImuBadLengths,
+  kGnssFrames,
+  kGnssSkippedBytes,
+  kGnssChecksumErrors,
+  kGnssBadLengths,
+  kImuBytes,
+  kImuFrames,
+  kImuSkippedBytes,
+  kImuChecksumErrors,
+  kImuBadLengths,
   kSerialDisconnects,
-  kPoseFixes, kPoseHighPrecisionFixes, kPoseInvalidPosition, kPoseMalformedMessages, kPoseAttitudes,
-  kPoseImuWithoutAttitude, kPoseRefusedSamples, kPoseGnssClockResets, kPoseImuClockResets,
-  kSweepsPointsTruncated, kTrajectorySwaps, kTrajectoryProjectionReacquired,
+  kPoseFixes,
+  kPoseHighPrecisionFixes,
+  kPoseInvalidPosition,
+  kPoseMalformedMessages,
+  kPoseAttitudes,
+  kPoseImuWithoutAttitude,
+  kPoseRefusedSamples,
+  kPoseGnssClockResets,
+  kPoseImuClockResets,
+  kSweepsPointsTruncated,
+  kTrajectorySwaps,
+  kTrajectoryProjectionReacquired,
   kCount
 };
 inline constexpr std::size_t kCounterCount = static_cast<std::size_t>(Counter::kCount);

@@ -1,25 +1,24 @@
 #include "trajroi/daemon/sweep_processor.hpp"
 
-#include "trajroi/config/text_file.hpp"
-
-#include <array>
 #include <algorithm>
+#include <array>
 #include <fstream>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
 
+#include "trajroi/config/text_file.hpp"
 #include "trajroi/roi/transform.hpp"
 
 namespace trajroi::daemon {
 namespace {
 
-constexpr std::size_t kScratchPoints = 1024;       // more than one packet's 384 points
+constexpr std::size_t kScratchPoints = 1024;  // more than one packet's 384 points
 // The speed is the distance to the pose this long before, over the time. The pose must have
 // been valid at every sweep start since then: right after a gap in the pose (a GNSS outage)
 // the shorter baselines are tried, and in the first 0.1 s none (the speed is unknown).
 constexpr std::array<std::int64_t, 3> kSpeedBaselines_ns{500'000'000, 200'000'000, 100'000'000};
-constexpr double kMaxAdvancePerSweep_m = 10.0;    // projection search window (50 m/s at 5 Hz)
+constexpr double kMaxAdvancePerSweep_m = 10.0;  // projection search window (50 m/s at 5 Hz)
 // Farther than this from the windowed projection, the robot is not where the window assumed
 // (its pose jumped: relocalised, carried, a replay looping): the whole trajectory is searched.
 constexpr double kReacquireDistance_m = 5.0;
@@ -60,7 +59,9 @@ PublishedPose PublishedPose::from(const Eigen::Isometry3d& pose) {
   return p;
 }
 
-Eigen::Isometry3d PublishedPose::isometry() const { return roi::pose_from_position_quaternion(position_m, orientation); }
+Eigen::Isometry3d PublishedPose::isometry() const {
+  return roi::pose_from_position_quaternion(position_m, orientation);
+}
 
 void Sweep::reserve(std::size_t points, std::size_t centre_count) {
   x.reserve(points);
@@ -101,9 +102,9 @@ SweepProcessor::SweepProcessor(const DaemonConfig& config, std::unique_ptr<Activ
       decoder_(load_calibration(config.lidar.calibration), stream_options(config)),
       poses_(config.gate, config.gnss_antenna_m, config.pose_capacity),
       pose_input_(pose::GlobalFrame::local_cartesian(config.origin), pose_input_config(config), poses_),
-      firing_(poses_, config.lidar.robot_from_lidar,
-              config.pose_mode == PoseMode::kPerSweep ? std::numeric_limits<std::int64_t>::max()
-                                                      : vlp16::kFiringCycle_ns),
+      firing_(
+          poses_, config.lidar.robot_from_lidar,
+          config.pose_mode == PoseMode::kPerSweep ? std::numeric_limits<std::int64_t>::max() : vlp16::kFiringCycle_ns),
       active_(std::move(trajectory)),
       circles_(config.roi.circle_diameter_m / 2.0, {}, roi::ZLimits{config.roi.z_min_m, config.roi.z_max_m}),
       rects_(config.roi.rect_height_m, config.roi.rect_width_m, {},
@@ -151,7 +152,9 @@ void SweepProcessor::offer_trajectory(std::unique_ptr<ActiveTrajectory> trajecto
   pending_ = std::move(trajectory);
 }
 
-std::unique_ptr<ActiveTrajectory> SweepProcessor::take_retired() noexcept { return std::move(retired_); }
+std::unique_ptr<ActiveTrajectory> SweepProcessor::take_retired() noexcept {
+  return std::move(retired_);
+}
 
 void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
   in_sweep_ = true;
@@ -194,16 +197,16 @@ void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
     if (frame.start_time_ns - baseline < *valid_since_ns_) continue;
     const pose::PoseQuery before = poses_.pose_at(frame.start_time_ns - baseline);
     if (before.valid()) {
-      s.speed_mps = (position - before.global_from_robot.translation().head<2>()).norm() /
-                    (static_cast<double>(baseline) * 1e-9);
+      s.speed_mps =
+          (position - before.global_from_robot.translation().head<2>()).norm() / (static_cast<double>(baseline) * 1e-9);
       s.speed_known = true;
       break;
     }
   }
 
   const roi::Trajectory& trajectory = active_->trajectory;
-  roi::Projection p = have_hint_ ? trajectory.project(position, s_hint_m_, kMaxAdvancePerSweep_m)
-                                 : trajectory.project(position);
+  roi::Projection p =
+      have_hint_ ? trajectory.project(position, s_hint_m_, kMaxAdvancePerSweep_m) : trajectory.project(position);
   if (have_hint_ && p.distance_m > kReacquireDistance_m) {
     const roi::Projection anywhere = trajectory.project(position);
     if (anywhere.distance_m < p.distance_m) {
@@ -289,7 +292,8 @@ void SweepProcessor::filter_run(const vlp16::Frame& frame, std::size_t first, st
     (void)rect_grid_.filter(placed, kept_);
   }
   Sweep& s = sweep_;
-  const std::size_t room = config_.buffers.max_points_per_sweep - std::min(config_.buffers.max_points_per_sweep, s.size());
+  const std::size_t room =
+      config_.buffers.max_points_per_sweep - std::min(config_.buffers.max_points_per_sweep, s.size());
   const std::size_t n = std::min(room, kept_.size());
   s.truncated += static_cast<std::uint32_t>(kept_.size() - n);
   for (std::size_t k = 0; k < n; ++k) {
@@ -304,7 +308,8 @@ void SweepProcessor::filter_run(const vlp16::Frame& frame, std::size_t first, st
     s.time_offset_ns.push_back(static_cast<std::int32_t>(p.time_offset_ns));
   }
   if (keep_indices_) {
-    for (std::size_t k = 0; k < n; ++k) s.point_index.push_back(static_cast<std::uint32_t>(first + kept_[k]));
+    for (std::size_t k = 0; k < n; ++k)
+      s.point_index.push_back(static_cast<std::uint32_t>(first + kept_[k]));
   }
 }
 

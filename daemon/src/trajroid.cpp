@@ -30,8 +30,8 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
     inputs::RecordedOptions recorded;
     recorded.rate = options.rate;
     recorded.loop = options.loop;
-    pipeline.add_input(std::make_unique<inputs::RecordedInput>(*options.replay, recorded),
-                       config.buffers.lidar_packets, "trajroid-replay", config.realtime.lidar);
+    pipeline.add_input(std::make_unique<inputs::RecordedInput>(*options.replay, recorded), config.buffers.lidar_packets,
+                       "trajroid-replay", config.realtime.lidar);
     return;
   }
   vlp16::UdpOptions udp;
@@ -78,12 +78,12 @@ void log_summary(const Pipeline& pipeline, const Publisher& publisher, std::int6
   const LatencyHistogram& latency = publisher.latency();
   const double wall_s = static_cast<double>(steady_ns() - start_ns) * 1e-9;
   const auto& p = s.processor;
-  log::info("summary: {:.2f} s | sweeps {} published {} withheld (no pose) {} | points in {} kept {} ({:.1f} %) | "
-            "latency p50 {:.3f} ms p99 {:.3f} ms over {} sweeps | ring drops {} | lost packets {} | decode errors {}",
-            wall_s, p.sweeps, p.sweeps_filtered, p.sweeps_without_pose, p.points_in, p.points_kept,
-            p.points_in > 0 ? 100.0 * static_cast<double>(p.points_kept) / static_cast<double>(p.points_in) : 0.0,
-            latency.quantile(0.5), latency.quantile(0.99), latency.count(), s.ring_drops(), s.lost_packets,
-            s.decode_errors);
+  log::info(
+      "summary: {:.2f} s | sweeps {} published {} withheld (no pose) {} | points in {} kept {} ({:.1f} %) | "
+      "latency p50 {:.3f} ms p99 {:.3f} ms over {} sweeps | ring drops {} | lost packets {} | decode errors {}",
+      wall_s, p.sweeps, p.sweeps_filtered, p.sweeps_without_pose, p.points_in, p.points_kept,
+      p.points_in > 0 ? 100.0 * static_cast<double>(p.points_kept) / static_cast<double>(p.points_in) : 0.0,
+      latency.quantile(0.5), latency.quantile(0.99), latency.count(), s.ring_drops(), s.lost_packets, s.decode_errors);
   log::info("cpu: sources {:.3f} s ({}), processing {:.3f} s, publishing {:.3f} s",
             static_cast<double>(pipeline.cpu_sources_ns.load()) * 1e-9, replay ? "replay reader" : "receive threads",
             static_cast<double>(pipeline.cpu_processing_ns.load()) * 1e-9,
@@ -105,7 +105,8 @@ int run_pipeline(Pipeline& pipeline, SweepProcessor& processor, Outlet& outlet, 
   threads.emplace_back([&] { processing_loop(pipeline, processor, processing); });
   threads.emplace_back([&] { publisher.run(); });
   if (pipeline.record) threads.emplace_back([&] { recorder_loop(pipeline, *options.record); });
-  for (const auto& lane : pipeline.inputs) threads.emplace_back([&pipeline, &lane] { input_loop(pipeline, *lane); });
+  for (const auto& lane : pipeline.inputs)
+    threads.emplace_back([&pipeline, &lane] { input_loop(pipeline, *lane); });
   sd_notify(0, "READY=1\nSTATUS=running");
 
   std::uint64_t watchdog_usec = 0;
@@ -140,7 +141,8 @@ int run_pipeline(Pipeline& pipeline, SweepProcessor& processor, Outlet& outlet, 
     }
   }
   pipeline.stop.store(true);
-  for (std::thread& t : threads) t.join();
+  for (std::thread& t : threads)
+    t.join();
   if (sfd >= 0) close(sfd);
   log_summary(pipeline, publisher, start_ns, options.replay.has_value());
   return 0;

@@ -7,15 +7,13 @@
 
 namespace trajroi::roi {
 
-void place_centres(const Trajectory& trajectory, double s0_m, double look_ahead_m,
-                   double spacing_m, std::vector<Centre>& out) {
+void place_centres(const Trajectory& trajectory, double s0_m, double look_ahead_m, double spacing_m,
+                   std::vector<Centre>& out) {
   if (!std::isfinite(spacing_m) || spacing_m <= 0.0) {
-    throw std::invalid_argument("ROI spacing must be finite and positive, got " +
-                                std::to_string(spacing_m));
+    throw std::invalid_argument("ROI spacing must be finite and positive, got " + std::to_string(spacing_m));
   }
   if (std::isnan(look_ahead_m) || look_ahead_m < 0.0) {
-    throw std::invalid_argument("ROI look-ahead must be non-negative, got " +
-                                std::to_string(look_ahead_m));
+    throw std::invalid_argument("ROI look-ahead must be non-negative, got " + std::to_string(look_ahead_m));
   }
   const double length = trajectory.length_m();
   const double s0 = std::isnan(s0_m) ? 0.0 : std::clamp(s0_m, 0.0, length);
@@ -25,9 +23,8 @@ void place_centres(const Trajectory& trajectory, double s0_m, double look_ahead_
   const double span = s0 + look_ahead_m <= length ? look_ahead_m : length - s0;
   const double steps = std::floor(span / spacing_m + 1e-9);
   if (!(steps < static_cast<double>(kMaxCentres))) {
-    throw std::invalid_argument("ROI spacing " + std::to_string(spacing_m) + " m over " +
-                                std::to_string(span) + " m gives more than " +
-                                std::to_string(kMaxCentres) + " centres");
+    throw std::invalid_argument("ROI spacing " + std::to_string(spacing_m) + " m over " + std::to_string(span) +
+                                " m gives more than " + std::to_string(kMaxCentres) + " centres");
   }
   const auto count = static_cast<std::size_t>(steps) + 1;
   out.clear();

@@ -11,10 +11,7 @@ CuboidExtent centred_cuboid(double length_m, double width_m, double z_min_m, dou
 }
 
 CuboidRoi::CuboidRoi(const Eigen::Isometry3d& global_from_robot, const CuboidExtent& extent)
-    : pose_(global_from_robot),
-      r_(global_from_robot.linear()),
-      t_(global_from_robot.translation()),
-      e_(extent) {
+    : pose_(global_from_robot), r_(global_from_robot.linear()), t_(global_from_robot.translation()), e_(extent) {
   auto check = [](double lo, double hi, const char* axis) {
     if (std::isnan(lo) || std::isnan(hi) || lo > hi) {
       throw std::invalid_argument(std::string("cuboid ") + axis + " extent must satisfy min <= max, got [" +

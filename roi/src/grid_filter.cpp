@@ -35,9 +35,8 @@ void GridFilter<RoiSet>::build(const RoiSet& rois) {
   // Rounding in the per-point tests and in locating a point's cell is a few ulps of the
   // coordinates' magnitude; a margin of 1e-9 of that magnitude dwarfs it, and at 1 nm for
   // local coordinates it changes no classification that matters.
-  const double magnitude = std::max({std::abs(bb.x_min), std::abs(bb.x_max), std::abs(bb.y_min),
-                                     std::abs(bb.y_max), bb.x_max - bb.x_min, bb.y_max - bb.y_min,
-                                     1.0});
+  const double magnitude = std::max({std::abs(bb.x_min), std::abs(bb.x_max), std::abs(bb.y_min), std::abs(bb.y_max),
+                                     bb.x_max - bb.x_min, bb.y_max - bb.y_min, 1.0});
   const double tolerance = 1e-9 * magnitude;
   // filter() locates a point's cell in float (a few float roundings, < 3e-7 of the magnitude):
   // every cell is classified as if it were larger by this pad, so a point the float
@@ -50,7 +49,8 @@ void GridFilter<RoiSet>::build(const RoiSet& rois) {
   double h = rois.cell_size_hint_m();
   if (std::ceil(width / h) * std::ceil(height / h) > static_cast<double>(kMaxCells)) {
     h = std::sqrt(width * height / static_cast<double>(kMaxCells)) * 1.01;
-    while (std::ceil(width / h) * std::ceil(height / h) > static_cast<double>(kMaxCells)) h *= 1.01;
+    while (std::ceil(width / h) * std::ceil(height / h) > static_cast<double>(kMaxCells))
+      h *= 1.01;
   }
   // The float origin and scale filter() uses define the grid; classification uses the same
   // values widened to double, so both describe the same cells up to float rounding.
@@ -81,16 +81,18 @@ void GridFilter<RoiSet>::build(const RoiSet& rois) {
       for (std::size_t ix = ix0; ix <= ix1; ++ix) {
         const std::size_t c = iy * nx_ + ix;
         if (cells_[c] == kInside) continue;
-        const Box cell{x0 + static_cast<double>(ix) * h - cell_pad,
-                       y0 + static_cast<double>(iy) * h - cell_pad,
+        const Box cell{x0 + static_cast<double>(ix) * h - cell_pad, y0 + static_cast<double>(iy) * h - cell_pad,
                        x0 + static_cast<double>(ix + 1) * h + cell_pad,
                        y0 + static_cast<double>(iy + 1) * h + cell_pad};
         switch (rois.relation(j, cell, tolerance)) {
-          case CellRelation::kInside: cells_[c] = kInside; break;
+          case CellRelation::kInside:
+            cells_[c] = kInside;
+            break;
           case CellRelation::kBoundary:
             pairs_.emplace_back(static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(j));
             break;
-          case CellRelation::kOutside: break;
+          case CellRelation::kOutside:
+            break;
         }
       }
     }
@@ -109,7 +111,8 @@ void GridFilter<RoiSet>::build(const RoiSet& rois) {
     ++cursor_[cells_[c] - kFirstBoundary];
   }
   offsets_.assign(boundary + 1, 0);
-  for (std::uint32_t id = 0; id < boundary; ++id) offsets_[id + 1] = offsets_[id] + cursor_[id];
+  for (std::uint32_t id = 0; id < boundary; ++id)
+    offsets_[id + 1] = offsets_[id] + cursor_[id];
   std::copy(offsets_.begin(), offsets_.end() - 1, cursor_.begin());
   candidates_.resize(offsets_.back());
   for (const auto& [c, j] : pairs_) {
@@ -151,8 +154,8 @@ void GridFilter<RoiSet>::build(const RoiSet& rois) {
     const double cy0 = y0 + static_cast<double>(c / nx_) * h;
     for (std::uint32_t sy = 0; sy < kSub; ++sy) {
       for (std::uint32_t sx = 0; sx < kSub; ++sx) {
-        const Box sub{cx0 + sx * hs - cell_pad, cy0 + sy * hs - cell_pad,
-                      cx0 + (sx + 1) * hs + cell_pad, cy0 + (sy + 1) * hs + cell_pad};
+        const Box sub{cx0 + sx * hs - cell_pad, cy0 + sy * hs - cell_pad, cx0 + (sx + 1) * hs + cell_pad,
+                      cy0 + (sy + 1) * hs + cell_pad};
         const std::size_t first = sub_candidates_.size();
         std::uint32_t value = kOutside;
         for (std::uint32_t k = offsets_[id]; k < offsets_[id + 1]; ++k) {
@@ -176,7 +179,8 @@ void GridFilter<RoiSet>::build(const RoiSet& rois) {
 }
 
 template <typename RoiSet>
-__attribute__((always_inline)) inline std::uint32_t GridFilter<RoiSet>::decide(std::uint32_t cell, double x, double y) const noexcept {
+__attribute__((always_inline)) inline std::uint32_t GridFilter<RoiSet>::decide(std::uint32_t cell, double x,
+                                                                               double y) const noexcept {
   if (cell < kFirstBoundary) return cell;  // kOutside = 0, kInside = 1
   // The sub-cell from the same float arithmetic that chose the cell: its integer part is
   // the cell, its fraction (exact in float) the position inside it.
@@ -197,8 +201,7 @@ __attribute__((always_inline)) inline std::uint32_t GridFilter<RoiSet>::decide(s
 
 template <typename RoiSet>
 template <typename Point>
-void GridFilter<RoiSet>::scalar_point(std::span<const Point> points, std::size_t i,
-                                      Scan& scan) const {
+void GridFilter<RoiSet>::scalar_point(std::span<const Point> points, std::size_t i, Scan& scan) const {
   const auto x = static_cast<double>(points[i].x);
   const auto y = static_cast<double>(points[i].y);
   const auto z = static_cast<double>(points[i].z);
@@ -237,7 +240,8 @@ FilterStats GridFilter<RoiSet>::filter(std::span<const Point> points, IndexVecto
     }
 #endif
   }
-  for (; i < points.size(); ++i) scalar_point(points, i, scan);
+  for (; i < points.size(); ++i)
+    scalar_point(points, i, scan);
   kept.resize(scan.count);
   stats.kept = scan.count;
   return stats;
@@ -326,22 +330,21 @@ std::size_t GridFilter<RoiSet>::scan_sse2(std::span<const PointXYZI> points, Sca
 }
 
 template <typename RoiSet>
-std::size_t GridFilter<RoiSet>::scalar_block(std::span<const PointXYZI> points, std::size_t first,
-                                             std::size_t n, Scan& scan, std::size_t count) const {
+std::size_t GridFilter<RoiSet>::scalar_block(std::span<const PointXYZI> points, std::size_t first, std::size_t n,
+                                             Scan& scan, std::size_t count) const {
   scan.count = count;
-  for (std::size_t k = first; k < first + n; ++k) scalar_point(points, k, scan);
+  for (std::size_t k = first; k < first + n; ++k)
+    scalar_point(points, k, scan);
   return scan.count;
 }
 
 template <typename RoiSet>
 unsigned GridFilter<RoiSet>::decide_lanes(unsigned boundary, const std::uint32_t* value,
-                                          std::span<const PointXYZI> points,
-                                          std::size_t first) const {
+                                          std::span<const PointXYZI> points, std::size_t first) const {
   unsigned keep = 0;
   for (; boundary != 0; boundary &= boundary - 1) {
     const auto k = static_cast<unsigned>(__builtin_ctz(boundary));
-    keep |= decide(value[k], static_cast<double>(points[first + k].x),
-                   static_cast<double>(points[first + k].y)) << k;
+    keep |= decide(value[k], static_cast<double>(points[first + k].x), static_cast<double>(points[first + k].y)) << k;
   }
   return keep;
 }
@@ -380,12 +383,11 @@ struct Avx2Block {
   bool clean;
 };
 
-__attribute__((target("avx2"), always_inline)) inline Avx2Block avx2_block(const float* p,
-                                                                          const Avx2Grid& g) {
-  const __m256 a = _mm256_loadu_ps(p);       // points 0, 1
-  const __m256 b = _mm256_loadu_ps(p + 8);   // points 2, 3
-  const __m256 c = _mm256_loadu_ps(p + 16);  // points 4, 5
-  const __m256 d = _mm256_loadu_ps(p + 24);  // points 6, 7
+__attribute__((target("avx2"), always_inline)) inline Avx2Block avx2_block(const float* p, const Avx2Grid& g) {
+  const __m256 a = _mm256_loadu_ps(p);         // points 0, 1
+  const __m256 b = _mm256_loadu_ps(p + 8);     // points 2, 3
+  const __m256 c = _mm256_loadu_ps(p + 16);    // points 4, 5
+  const __m256 d = _mm256_loadu_ps(p + 24);    // points 6, 7
   const __m256 t0 = _mm256_unpacklo_ps(a, b);  // x0 x2 y0 y2 | x1 x3 y1 y3
   const __m256 t1 = _mm256_unpackhi_ps(a, b);  // z0 z2 . .   | z1 z3 . .
   const __m256 t2 = _mm256_unpacklo_ps(c, d);
@@ -395,20 +397,19 @@ __attribute__((target("avx2"), always_inline)) inline Avx2Block avx2_block(const
   const __m256 pz = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
   const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
   const __m256 max_finite = _mm256_set1_ps(std::numeric_limits<float>::max());
-  __m256 pass = _mm256_and_ps(
-      _mm256_and_ps(_mm256_cmp_ps(_mm256_and_ps(px, abs_mask), max_finite, _CMP_LE_OQ),
-                    _mm256_cmp_ps(_mm256_and_ps(py, abs_mask), max_finite, _CMP_LE_OQ)),
-      _mm256_cmp_ps(_mm256_and_ps(pz, abs_mask), max_finite, _CMP_LE_OQ));
+  __m256 pass = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(_mm256_and_ps(px, abs_mask), max_finite, _CMP_LE_OQ),
+                                            _mm256_cmp_ps(_mm256_and_ps(py, abs_mask), max_finite, _CMP_LE_OQ)),
+                              _mm256_cmp_ps(_mm256_and_ps(pz, abs_mask), max_finite, _CMP_LE_OQ));
   if (g.z_limited) {
-    pass = _mm256_and_ps(pass, _mm256_and_ps(_mm256_cmp_ps(pz, g.z_lo, _CMP_GE_OQ),
-                                             _mm256_cmp_ps(pz, g.z_hi, _CMP_LE_OQ)));
+    pass = _mm256_and_ps(pass,
+                         _mm256_and_ps(_mm256_cmp_ps(pz, g.z_lo, _CMP_GE_OQ), _mm256_cmp_ps(pz, g.z_hi, _CMP_LE_OQ)));
   }
   const __m256 zero = _mm256_setzero_ps();
   const __m256 fx = _mm256_mul_ps(_mm256_sub_ps(px, g.x0), g.inv);
   const __m256 fy = _mm256_mul_ps(_mm256_sub_ps(py, g.y0), g.inv);
-  const __m256 on_grid = _mm256_and_ps(
-      _mm256_and_ps(_mm256_cmp_ps(fx, zero, _CMP_GE_OQ), _mm256_cmp_ps(fx, g.nx_f, _CMP_LT_OQ)),
-      _mm256_and_ps(_mm256_cmp_ps(fy, zero, _CMP_GE_OQ), _mm256_cmp_ps(fy, g.ny_f, _CMP_LT_OQ)));
+  const __m256 on_grid =
+      _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(fx, zero, _CMP_GE_OQ), _mm256_cmp_ps(fx, g.nx_f, _CMP_LT_OQ)),
+                    _mm256_and_ps(_mm256_cmp_ps(fy, zero, _CMP_GE_OQ), _mm256_cmp_ps(fy, g.ny_f, _CMP_LT_OQ)));
   // Off-grid lanes are zeroed before converting; on-grid values are ≥ 0 (truncation floors).
   const __m256i ix = _mm256_cvttps_epi32(_mm256_and_ps(fx, on_grid));
   const __m256i iy = _mm256_cvttps_epi32(_mm256_and_ps(fy, on_grid));
@@ -428,13 +429,12 @@ struct Avx2Reuse {
   __m256i value;  // the cell table's entries for `cell`
 };
 
-__attribute__((target("avx2"), always_inline)) inline __m256i avx2_values(__m256i cell,
-                                                                         Avx2Reuse& reuse,
-                                                                         const int* cells) {
+__attribute__((target("avx2"), always_inline)) inline __m256i avx2_values(__m256i cell, Avx2Reuse& reuse,
+                                                                          const int* cells) {
   const __m256i same = _mm256_cmpeq_epi32(cell, reuse.cell);
   if (_mm256_movemask_ps(_mm256_castsi256_ps(same)) != 0xff) {
-    reuse.value = _mm256_mask_i32gather_epi32(reuse.value, cells, cell,
-                                              _mm256_xor_si256(same, _mm256_set1_epi32(-1)), 4);
+    reuse.value =
+        _mm256_mask_i32gather_epi32(reuse.value, cells, cell, _mm256_xor_si256(same, _mm256_set1_epi32(-1)), 4);
     reuse.cell = cell;
   }
   return reuse.value;
@@ -442,12 +442,12 @@ __attribute__((target("avx2"), always_inline)) inline __m256i avx2_values(__m256
 
 // Writes the indices first … first + 7 whose bit is set in `keep` to out, packed; returns
 // how many. Writes eight slots at `out`.
-__attribute__((target("avx2,popcnt"), always_inline)) inline std::size_t avx2_emit(
-    unsigned keep, std::size_t first, std::uint32_t* out) {
-  const __m256i indices = _mm256_add_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(first)),
-                                           _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-  const __m256i packed = _mm256_permutevar8x32_epi32(
-      indices, _mm256_load_si256(reinterpret_cast<const __m256i*>(kCompress.lanes[keep])));
+__attribute__((target("avx2,popcnt"), always_inline)) inline std::size_t avx2_emit(unsigned keep, std::size_t first,
+                                                                                   std::uint32_t* out) {
+  const __m256i indices =
+      _mm256_add_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(first)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+  const __m256i packed =
+      _mm256_permutevar8x32_epi32(indices, _mm256_load_si256(reinterpret_cast<const __m256i*>(kCompress.lanes[keep])));
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), packed);
   return static_cast<std::size_t>(__builtin_popcount(keep));
 }
@@ -468,22 +468,21 @@ __attribute__((target("avx2"), always_inline)) inline void avx2_store(__m256i va
 }  // namespace detail
 
 template <typename RoiSet>
-__attribute__((target("avx2,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx2(
-    std::span<const PointXYZI> points, Scan& scan) const {
+__attribute__((target("avx2,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx2(std::span<const PointXYZI> points,
+                                                                                 Scan& scan) const {
   if (points.size() < 8) return 0;
   const FloatZLimits z = float_z_limits(rois_->z_limits());
-  const detail::Avx2Grid grid{
-      _mm256_set1_ps(x0_),
-      _mm256_set1_ps(y0_),
-      _mm256_set1_ps(inv_cell_),
-      _mm256_set1_ps(static_cast<float>(nx_)),
-      _mm256_set1_ps(static_cast<float>(ny_)),
-      _mm256_set1_ps(z.lo),
-      _mm256_set1_ps(z.hi),
-      _mm256_set1_epi32(static_cast<std::int32_t>(nx_)),
-      _mm256_set1_epi32(static_cast<std::int32_t>(cells_.size() - 1)),
-      z.limited,
-      reinterpret_cast<const int*>(cells_.data())};
+  const detail::Avx2Grid grid{_mm256_set1_ps(x0_),
+                              _mm256_set1_ps(y0_),
+                              _mm256_set1_ps(inv_cell_),
+                              _mm256_set1_ps(static_cast<float>(nx_)),
+                              _mm256_set1_ps(static_cast<float>(ny_)),
+                              _mm256_set1_ps(z.lo),
+                              _mm256_set1_ps(z.hi),
+                              _mm256_set1_epi32(static_cast<std::int32_t>(nx_)),
+                              _mm256_set1_epi32(static_cast<std::int32_t>(cells_.size() - 1)),
+                              z.limited,
+                              reinterpret_cast<const int*>(cells_.data())};
   const float* const base = &points.data()->x;
   std::uint32_t* const out = scan.out;
   std::size_t count = scan.count;
@@ -491,7 +490,7 @@ __attribute__((target("avx2,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx2
   // accepts, in order. A block with a point to reject goes to the scalar code, which counts
   // why. Since count ≤ first, an 8-slot store at out + count stays within first + 8 ≤ n.
   auto finish = [&](std::size_t first, const detail::Avx2Block& block, detail::Avx2Reuse& reuse)
-                    __attribute__((target("avx2,popcnt"))) {
+      __attribute__((target("avx2,popcnt"))) {
     if (!block.clean) [[unlikely]] {
       count = scalar_block(points, first, 8, scan, count);
       return;
@@ -516,7 +515,8 @@ __attribute__((target("avx2,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx2
     finish(i, a, first_half);
     finish(i + 8, b, second_half);
   }
-  for (; i + 8 <= points.size(); i += 8) finish(i, detail::avx2_block(base + 4 * i, grid), first_half);
+  for (; i + 8 <= points.size(); i += 8)
+    finish(i, detail::avx2_block(base + 4 * i, grid), first_half);
   scan.count = count;
   return i;
 }
@@ -536,8 +536,7 @@ struct Avx512Block {
   bool clean;
 };
 
-__attribute__((target("avx512f"), always_inline)) inline Avx512Block avx512_block(
-    const float* p, const Avx512Grid& g) {
+__attribute__((target("avx512f"), always_inline)) inline Avx512Block avx512_block(const float* p, const Avx512Grid& g) {
   const __m512 a = _mm512_loadu_ps(p);       // points 0–3
   const __m512 b = _mm512_loadu_ps(p + 16);  // points 4–7
   const __m512 c = _mm512_loadu_ps(p + 32);  // points 8–11
@@ -559,15 +558,14 @@ __attribute__((target("avx512f"), always_inline)) inline Avx512Block avx512_bloc
                    _mm512_cmp_ps_mask(_mm512_abs_ps(py), max_finite, _CMP_LE_OQ) &
                    _mm512_cmp_ps_mask(_mm512_abs_ps(pz), max_finite, _CMP_LE_OQ);
   if (g.z_limited) {
-    pass = _mm512_kand(pass, _mm512_kand(_mm512_cmp_ps_mask(pz, g.z_lo, _CMP_GE_OQ),
-                                         _mm512_cmp_ps_mask(pz, g.z_hi, _CMP_LE_OQ)));
+    pass = _mm512_kand(
+        pass, _mm512_kand(_mm512_cmp_ps_mask(pz, g.z_lo, _CMP_GE_OQ), _mm512_cmp_ps_mask(pz, g.z_hi, _CMP_LE_OQ)));
   }
   const __m512 zero = _mm512_setzero_ps();
   const __m512 fx = _mm512_mul_ps(_mm512_sub_ps(px, g.x0), g.inv);
   const __m512 fy = _mm512_mul_ps(_mm512_sub_ps(py, g.y0), g.inv);
-  const __mmask16 on_grid =
-      _mm512_cmp_ps_mask(fx, zero, _CMP_GE_OQ) & _mm512_cmp_ps_mask(fx, g.nx_f, _CMP_LT_OQ) &
-      _mm512_cmp_ps_mask(fy, zero, _CMP_GE_OQ) & _mm512_cmp_ps_mask(fy, g.ny_f, _CMP_LT_OQ);
+  const __mmask16 on_grid = _mm512_cmp_ps_mask(fx, zero, _CMP_GE_OQ) & _mm512_cmp_ps_mask(fx, g.nx_f, _CMP_LT_OQ) &
+                            _mm512_cmp_ps_mask(fy, zero, _CMP_GE_OQ) & _mm512_cmp_ps_mask(fy, g.ny_f, _CMP_LT_OQ);
   // On-grid values are ≥ 0 (truncation floors).
   const __m512i ix = _mm512_maskz_cvttps_epi32(on_grid, fx);
   const __m512i iy = _mm512_maskz_cvttps_epi32(on_grid, fy);
@@ -581,9 +579,8 @@ struct Avx512Reuse {
   __m512i value;
 };
 
-__attribute__((target("avx512f"), always_inline)) inline __m512i avx512_values(__m512i cell,
-                                                                             Avx512Reuse& reuse,
-                                                                             const int* cells) {
+__attribute__((target("avx512f"), always_inline)) inline __m512i avx512_values(__m512i cell, Avx512Reuse& reuse,
+                                                                               const int* cells) {
   const __mmask16 changed = _mm512_cmpneq_epi32_mask(cell, reuse.cell);
   if (changed != 0) {
     reuse.value = _mm512_mask_i32gather_epi32(reuse.value, changed, cell, cells, 4);
@@ -594,8 +591,8 @@ __attribute__((target("avx512f"), always_inline)) inline __m512i avx512_values(_
 }  // namespace detail
 
 template <typename RoiSet>
-__attribute__((target("avx512f,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx512(
-    std::span<const PointXYZI> points, Scan& scan) const {
+__attribute__((target("avx512f,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx512(std::span<const PointXYZI> points,
+                                                                                      Scan& scan) const {
   if (points.size() < 16) return 0;
   const FloatZLimits z = float_z_limits(rois_->z_limits());
   const detail::Avx512Grid grid{_mm512_set1_ps(x0_),
@@ -618,16 +615,15 @@ __attribute__((target("avx512f,popcnt"))) std::size_t GridFilter<RoiSet>::scan_a
   // Keeps the block's inside points and those of its boundary points that a candidate ROI
   // accepts, in order. A block with a point to reject goes to the scalar code, which counts
   // why. Since count ≤ first, a 16-slot store at out + count stays within first + 16 ≤ n.
-  auto finish = [&](std::size_t first, const detail::Avx512Block& block)
-                    __attribute__((target("avx512f,popcnt"))) {
+  auto finish = [&](std::size_t first, const detail::Avx512Block& block) __attribute__((target("avx512f,popcnt"))) {
     if (!block.clean) [[unlikely]] {
       count = scalar_block(points, first, 16, scan, count);
       return;
     }
     const __m512i cell_value = detail::avx512_values(block.cell, reuse, grid.cells);
     auto keep = static_cast<unsigned>(_mm512_cmpeq_epi32_mask(cell_value, one));
-    if (const auto boundary = static_cast<unsigned>(_mm512_cmpgt_epu32_mask(cell_value, one));
-        boundary != 0) [[unlikely]] {
+    if (const auto boundary = static_cast<unsigned>(_mm512_cmpgt_epu32_mask(cell_value, one)); boundary != 0)
+        [[unlikely]] {
       alignas(64) std::uint32_t value[16];
       _mm512_store_si512(value, cell_value);
       keep |= decide_lanes(boundary, value, points, first);
@@ -644,7 +640,8 @@ __attribute__((target("avx512f,popcnt"))) std::size_t GridFilter<RoiSet>::scan_a
     finish(i, a);
     finish(i + 16, b);
   }
-  for (; i + 16 <= points.size(); i += 16) finish(i, detail::avx512_block(base + 4 * i, grid));
+  for (; i + 16 <= points.size(); i += 16)
+    finish(i, detail::avx512_block(base + 4 * i, grid));
   scan.count = count;
   return i;
 }
@@ -655,24 +652,22 @@ std::size_t GridFilter<RoiSet>::cell_index(float x, float y) const noexcept {
   // The same float operations as the SSE2 path: identical cells on either path.
   const float fx = (x - x0_) * inv_cell_;
   const float fy = (y - y0_) * inv_cell_;
-  const bool on_grid = fx >= 0.0f && fx < static_cast<float>(nx_) && fy >= 0.0f &&
-                       fy < static_cast<float>(ny_);  // false for NaN
+  const bool on_grid =
+      fx >= 0.0f && fx < static_cast<float>(nx_) && fy >= 0.0f && fy < static_cast<float>(ny_);  // false for NaN
   if (!on_grid) return cells_.size() - 1;
   const auto ix = static_cast<float>(static_cast<std::int32_t>(fx));
   const auto iy = static_cast<float>(static_cast<std::int32_t>(fy));
   return static_cast<std::size_t>(static_cast<std::int32_t>(iy * static_cast<float>(nx_) + ix));
 }
 
-
 template class GridFilter<CircularRoiSet>;
 template class GridFilter<RectangularRoiSet>;
 template class GridFilter<CorridorRoiSet>;
 
-#define TRAJROI_GRID_FILTER_POINTS(RoiSet)                                                              \
-  template FilterStats GridFilter<RoiSet>::filter<PointXYZI>(std::span<const PointXYZI>, IndexVector&, \
-                                                             SimdPath) const;                          \
-  template FilterStats GridFilter<RoiSet>::filter<PointXYZd>(std::span<const PointXYZd>, IndexVector&, \
-                                                             SimdPath) const;
+#define TRAJROI_GRID_FILTER_POINTS(RoiSet)                                                                       \
+  template FilterStats GridFilter<RoiSet>::filter<PointXYZI>(std::span<const PointXYZI>, IndexVector&, SimdPath) \
+      const;                                                                                                     \
+  template FilterStats GridFilter<RoiSet>::filter<PointXYZd>(std::span<const PointXYZd>, IndexVector&, SimdPath) const;
 TRAJROI_GRID_FILTER_POINTS(CircularRoiSet)
 TRAJROI_GRID_FILTER_POINTS(RectangularRoiSet)
 TRAJROI_GRID_FILTER_POINTS(CorridorRoiSet)

@@ -9,15 +9,14 @@ namespace {
 
 void require_positive(double value, const char* what) {
   if (!std::isfinite(value) || value <= 0.0) {
-    throw std::invalid_argument(std::string(what) + " must be finite and positive, got " +
-                                std::to_string(value));
+    throw std::invalid_argument(std::string(what) + " must be finite and positive, got " + std::to_string(value));
   }
 }
 
 void require_valid(const ZLimits& z) {
   if (std::isnan(z.min_m) || std::isnan(z.max_m) || z.min_m > z.max_m) {
-    throw std::invalid_argument("z limits must satisfy z_min <= z_max, got [" +
-                                std::to_string(z.min_m) + ", " + std::to_string(z.max_m) + "]");
+    throw std::invalid_argument("z limits must satisfy z_min <= z_max, got [" + std::to_string(z.min_m) + ", " +
+                                std::to_string(z.max_m) + "]");
   }
 }
 
@@ -47,8 +46,7 @@ void CircularRoiSet::assign(std::span<const Centre> centres, double radius_m) {
 }
 
 // ----------------------------------------------------------------------------------------
-RectGeometry make_rect_geometry(double cx, double cy, double theta_rad, double height_m,
-                                double width_m) noexcept {
+RectGeometry make_rect_geometry(double cx, double cy, double theta_rad, double height_m, double width_m) noexcept {
   // u = a/2 (cos θ, sin θ);  v = b / (2‖u‖) · (u_y, −u_x)
   const double ux = height_m / 2.0 * std::cos(theta_rad);
   const double uy = height_m / 2.0 * std::sin(theta_rad);
@@ -77,8 +75,7 @@ RectGeometry make_rect_geometry(double cx, double cy, double theta_rad, double h
   return g;
 }
 
-RectangularRoiSet::RectangularRoiSet(double height_m, double width_m,
-                                     std::span<const Centre> centres, ZLimits z)
+RectangularRoiSet::RectangularRoiSet(double height_m, double width_m, std::span<const Centre> centres, ZLimits z)
     : height_m_(height_m), width_m_(width_m), z_(z) {
   require_positive(height_m, "rectangular ROI height a");
   require_positive(width_m, "rectangular ROI width b");
@@ -89,8 +86,7 @@ RectangularRoiSet::RectangularRoiSet(double height_m, double width_m,
 void RectangularRoiSet::assign(std::span<const Centre> centres) {
   rects_.clear();
   for (const Centre& c : centres) {
-    rects_.push_back(
-        make_rect_geometry(c.position.x(), c.position.y(), c.theta_rad, height_m_, width_m_));
+    rects_.push_back(make_rect_geometry(c.position.x(), c.position.y(), c.theta_rad, height_m_, width_m_));
   }
 }
 
@@ -112,8 +108,7 @@ Box RectangularRoiSet::bounds(std::size_t j) const noexcept {
 }
 
 // ----------------------------------------------------------------------------------------
-CorridorRoiSet::CorridorRoiSet(const Trajectory& trajectory, double s0_m, double s1_m,
-                               double width_m, ZLimits z)
+CorridorRoiSet::CorridorRoiSet(const Trajectory& trajectory, double s0_m, double s1_m, double width_m, ZLimits z)
     : half_width_m_(width_m / 2.0), z_(z) {
   require_positive(width_m, "corridor width");
   require_valid(z);
@@ -154,8 +149,7 @@ Box CorridorRoiSet::bounds(std::size_t j) const noexcept {
           std::max(ax_[j], bx) + half_width_m_, std::max(ay_[j], by) + half_width_m_};
 }
 
-CellRelation CorridorRoiSet::relation(std::size_t j, const Box& cell,
-                                      double tolerance_m) const noexcept {
+CellRelation CorridorRoiSet::relation(std::size_t j, const Box& cell, double tolerance_m) const noexcept {
   // Distance to a segment is 1-Lipschitz: over the cell it stays within the half diagonal
   // of its value at the cell's centre.
   const double mx = 0.5 * (cell.x_min + cell.x_max);
@@ -163,9 +157,7 @@ CellRelation CorridorRoiSet::relation(std::size_t j, const Box& cell,
   const double half_diagonal = 0.5 * std::hypot(cell.x_max - cell.x_min, cell.y_max - cell.y_min);
   const double apx = mx - ax_[j];
   const double apy = my - ay_[j];
-  const double t = length2_[j] > 0.0
-                       ? std::clamp((apx * dx_[j] + apy * dy_[j]) / length2_[j], 0.0, 1.0)
-                       : 0.0;
+  const double t = length2_[j] > 0.0 ? std::clamp((apx * dx_[j] + apy * dy_[j]) / length2_[j], 0.0, 1.0) : 0.0;
   const double centre_distance = std::hypot(apx - t * dx_[j], apy - t * dy_[j]);
   if (centre_distance + half_diagonal <= half_width_m_ - tolerance_m) return CellRelation::kInside;
   if (centre_distance - half_diagonal > half_width_m_ + tolerance_m) return CellRelation::kOutside;

@@ -10,20 +10,23 @@ namespace trajroi::roi {
 
 std::string_view to_string(TrajectoryErrc code) noexcept {
   switch (code) {
-    case TrajectoryErrc::kTooFewPoints: return "too_few_points";
-    case TrajectoryErrc::kNonFinitePoint: return "non_finite_point";
-    case TrajectoryErrc::kTooManyPoints: return "too_many_points";
-    case TrajectoryErrc::kParse: return "parse";
+    case TrajectoryErrc::kTooFewPoints:
+      return "too_few_points";
+    case TrajectoryErrc::kNonFinitePoint:
+      return "non_finite_point";
+    case TrajectoryErrc::kTooManyPoints:
+      return "too_many_points";
+    case TrajectoryErrc::kParse:
+      return "parse";
   }
   return "unknown";
 }
 
 Trajectory::Trajectory(std::vector<Eigen::Vector2d> waypoints) {
   if (waypoints.size() > kMaxWaypoints) {
-    throw TrajectoryError(TrajectoryErrc::kTooManyPoints,
-                          "trajectory has " + std::to_string(waypoints.size()) +
-                              " waypoints, more than the limit of " +
-                              std::to_string(kMaxWaypoints));
+    throw TrajectoryError(TrajectoryErrc::kTooManyPoints, "trajectory has " + std::to_string(waypoints.size()) +
+                                                              " waypoints, more than the limit of " +
+                                                              std::to_string(kMaxWaypoints));
   }
   for (std::size_t i = 0; i < waypoints.size(); ++i) {
     if (!waypoints[i].allFinite()) {
@@ -37,8 +40,7 @@ Trajectory::Trajectory(std::vector<Eigen::Vector2d> waypoints) {
   }
   if (points_.size() < 2) {
     throw TrajectoryError(TrajectoryErrc::kTooFewPoints,
-                          "trajectory needs at least two distinct waypoints, got " +
-                              std::to_string(points_.size()));
+                          "trajectory needs at least two distinct waypoints, got " + std::to_string(points_.size()));
   }
   const std::size_t segments = points_.size() - 1;
   direction_.resize(segments);
@@ -79,15 +81,13 @@ Projection Trajectory::project(const Eigen::Vector2d& position) const noexcept {
   return project_range(position, 0.0, length_m());
 }
 
-Projection Trajectory::project(const Eigen::Vector2d& position, double s_hint_m,
-                               double max_advance_m) const noexcept {
+Projection Trajectory::project(const Eigen::Vector2d& position, double s_hint_m, double max_advance_m) const noexcept {
   const double lo = std::clamp(s_hint_m, 0.0, length_m());
   const double hi = std::clamp(lo + std::max(max_advance_m, 0.0), lo, length_m());
   return project_range(position, lo, hi);
 }
 
-Projection Trajectory::project_range(const Eigen::Vector2d& position, double s_lo,
-                                     double s_hi) const noexcept {
+Projection Trajectory::project_range(const Eigen::Vector2d& position, double s_lo, double s_hi) const noexcept {
   Projection best{s_lo, std::numeric_limits<double>::infinity(), point_at(s_lo)};
   const std::size_t first = segment_at(s_lo);
   const std::size_t last = segment_at(s_hi);
@@ -111,9 +111,9 @@ Trajectory parse_trajectory_csv(std::string_view text, std::string_view source_n
     if (content.empty()) return;
     double values[2];
     if (parse_csv_doubles(content, values) != 2) {
-      throw TrajectoryError(TrajectoryErrc::kParse,
-                            std::string(source_name) + ":" + std::to_string(line_number) +
-                                ": expected 'x,y' (metres), got '" + std::string(content) + "'");
+      throw TrajectoryError(TrajectoryErrc::kParse, std::string(source_name) + ":" + std::to_string(line_number) +
+                                                        ": expected 'x,y' (metres), got '" + std::string(content) +
+                                                        "'");
     }
     if (!std::isfinite(values[0]) || !std::isfinite(values[1])) {
       throw TrajectoryError(TrajectoryErrc::kNonFinitePoint,

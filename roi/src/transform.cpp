@@ -14,13 +14,15 @@ Eigen::Isometry3d pose_from_xy_yaw(double x_m, double y_m, double yaw_rad, doubl
 Eigen::Isometry3d pose_from_xyz_rpy(const Eigen::Vector3d& xyz_m, double roll_rad, double pitch_rad, double yaw_rad) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.translation() = xyz_m;
-  t.linear() = (Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch_rad, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(roll_rad, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
+  t.linear() =
+      (Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch_rad, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(roll_rad, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
   return t;
 }
 
-Eigen::Isometry3d pose_from_position_quaternion(const Eigen::Vector3d& position_m, const Eigen::Quaterniond& orientation) {
+Eigen::Isometry3d pose_from_position_quaternion(const Eigen::Vector3d& position_m,
+                                                const Eigen::Quaterniond& orientation) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.linear() = orientation.toRotationMatrix();
   t.translation() = position_m;
@@ -30,8 +32,7 @@ Eigen::Isometry3d pose_from_position_quaternion(const Eigen::Vector3d& position_
 namespace {
 
 template <typename Point>
-void transform_impl(const Eigen::Isometry3d& target_from_source, std::span<const Point> in,
-                    std::span<Point> out) {
+void transform_impl(const Eigen::Isometry3d& target_from_source, std::span<const Point> in, std::span<Point> out) {
   assert(in.size() == out.size());
   using Scalar = decltype(Point{}.x);
   const Eigen::Matrix3d& r = target_from_source.linear();

@@ -8,7 +8,8 @@
 
 namespace trajroi::test {
 
-inline std::vector<std::vector<double>> read_numeric_csv(const std::string& text, std::vector<std::string>* header = nullptr) {
+inline std::vector<std::vector<double>> read_numeric_csv(const std::string& text,
+                                                         std::vector<std::string>* header = nullptr) {
   std::vector<std::vector<double>> rows;
   std::istringstream in(text);
   std::string line;

@@ -29,7 +29,8 @@ class PcdCloud {
     const Field& f = field(name);
     if (f.type != 'F' || f.size != 4) throw std::runtime_error("PCD field " + name + " is not F4");
     std::vector<float> out(points_);
-    for (std::size_t i = 0; i < points_; ++i) std::memcpy(&out[i], record(i) + f.offset, 4);
+    for (std::size_t i = 0; i < points_; ++i)
+      std::memcpy(&out[i], record(i) + f.offset, 4);
     return out;
   }
 
@@ -39,7 +40,8 @@ class PcdCloud {
     std::vector<std::uint32_t> out(points_);
     for (std::size_t i = 0; i < points_; ++i) {
       std::uint32_t v = 0;
-      for (std::size_t b = 0; b < f.size; ++b) v |= static_cast<std::uint32_t>(record(i)[f.offset + b]) << (8 * b);
+      for (std::size_t b = 0; b < f.size; ++b)
+        v |= static_cast<std::uint32_t>(record(i)[f.offset + b]) << (8 * b);
       out[i] = v;
     }
     return out;
@@ -73,11 +75,14 @@ inline PcdCloud read_pcd(const std::filesystem::path& path) {
     std::string key;
     words >> key;
     if (key == "FIELDS") {
-      for (std::string w; words >> w;) names.push_back(w);
+      for (std::string w; words >> w;)
+        names.push_back(w);
     } else if (key == "SIZE") {
-      for (std::size_t w; words >> w;) sizes.push_back(w);
+      for (std::size_t w; words >> w;)
+        sizes.push_back(w);
     } else if (key == "TYPE") {
-      for (std::string w; words >> w;) types.push_back(w);
+      for (std::string w; words >> w;)
+        types.push_back(w);
     } else if (key == "COUNT") {
       for (std::size_t w; words >> w;) {
         if (w != 1) throw std::runtime_error(path.string() + ": PCD COUNT other than 1");

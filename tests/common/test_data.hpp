@@ -36,13 +36,12 @@ inline std::string read_file(const std::filesystem::path& path) {
 
 // Resolves `relative` inside the data folder into `path_var`. When the file is missing the
 // test is skipped with the reason, except under CI (CI=true), where a missing capture fails.
-#define TRAJROI_REQUIRE_DATA(path_var, relative)                                                  \
-  const std::filesystem::path path_var = ::trajroi::test::data_dir() / (relative);              \
-  if (!std::filesystem::exists(path_var)) {                                                       \
-    if (::trajroi::test::running_in_ci()) {                                                       \
-      FAIL() << "test data missing under CI: " << path_var << " (TRAJROI_DATA_DIR='"              \
-             << ::trajroi::test::data_dir().string() << "')";                                    \
-    }                                                                                             \
-    GTEST_SKIP() << "test data not found: " << path_var                                          \
-                 << " (set TRAJROI_DATA_DIR to the shared data folder)";                          \
+#define TRAJROI_REQUIRE_DATA(path_var, relative)                                                                \
+  const std::filesystem::path path_var = ::trajroi::test::data_dir() / (relative);                              \
+  if (!std::filesystem::exists(path_var)) {                                                                     \
+    if (::trajroi::test::running_in_ci()) {                                                                     \
+      FAIL() << "test data missing under CI: " << path_var << " (TRAJROI_DATA_DIR='"                            \
+             << ::trajroi::test::data_dir().string() << "')";                                                   \
+    }                                                                                                           \
+    GTEST_SKIP() << "test data not found: " << path_var << " (set TRAJROI_DATA_DIR to the shared data folder)"; \
   }

@@ -1,5 +1,7 @@
 // trajroid's configuration: the documented example reads, and every kind of mistake stops the
 // daemon with exit code 78 and a message naming the file, line, key and value.
+#include "trajroi/daemon/config.hpp"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -7,14 +9,15 @@
 #include <sstream>
 
 #include "daemon_fixture.hpp"
-#include "trajroi/daemon/config.hpp"
 
 namespace {
 
 using namespace trajroi::daemon;
 namespace fs = std::filesystem;
 
-std::string example() { return daemon_test::slurp(TRAJROI_EXAMPLE_CONFIG); }
+std::string example() {
+  return daemon_test::slurp(TRAJROI_EXAMPLE_CONFIG);
+}
 
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);
@@ -50,20 +53,24 @@ TEST(DaemonConfig, TheDocumentedExampleReadsWithItsValues) {
 
 TEST(DaemonConfig, MistakesAreNamedByFileLineKeyAndValue) {
   const std::string file = TRAJROI_EXAMPLE_CONFIG;
-  EXPECT_NE(error_of(replaced(example(), "  shape: circular", "  shape: hexagon")).find("roi.shape"), std::string::npos);
+  EXPECT_NE(error_of(replaced(example(), "  shape: circular", "  shape: hexagon")).find("roi.shape"),
+            std::string::npos);
   EXPECT_NE(error_of(replaced(example(), "  shape: circular", "  shape: hexagon")).find("hexagon"), std::string::npos);
   const std::string unknown = error_of(replaced(example(), "  data_port: 2368", "  data_prot: 2368"));
   EXPECT_NE(unknown.find("lidar.data_prot"), std::string::npos) << unknown;
   EXPECT_NE(unknown.find(file + ":"), std::string::npos) << unknown;
-  EXPECT_NE(error_of(replaced(example(), "  data_port: 2368", "  data_port: 70000")).find("lidar.data_port: must be a UDP port"),
+  EXPECT_NE(error_of(replaced(example(), "  data_port: 2368", "  data_port: 70000"))
+                .find("lidar.data_port: must be a UDP port"),
             std::string::npos);
-  EXPECT_NE(error_of(replaced(example(), "  max_h_acc_m: 0.5", "  max_h_acc_m: -1")).find("pose.max_h_acc_m: must be > 0"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(replaced(example(), "  max_h_acc_m: 0.5", "  max_h_acc_m: -1")).find("pose.max_h_acc_m: must be > 0"),
+      std::string::npos);
   EXPECT_NE(error_of(replaced(example(), "    lidar: {policy: other}", "    lidar: {policy: fifo, priority: 120}"))
                 .find("realtime.threads.lidar.priority"),
             std::string::npos);
-  EXPECT_NE(error_of(replaced(example(), "  spacing_ratio: 0.25", "  spacing_ratio: 0.000001")).find("roi.spacing_ratio"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(replaced(example(), "  spacing_ratio: 0.25", "  spacing_ratio: 0.000001")).find("roi.spacing_ratio"),
+      std::string::npos);
   EXPECT_NE(error_of(replaced(example(), "global_frame:", "global_fram:")).find("global_frame"), std::string::npos);
 }
 
@@ -75,8 +82,8 @@ struct DaemonRun {
 DaemonRun trajroid(const fs::path& config, const std::string& extra = "") {
   // stderr goes to the temporary folder, never beside the configuration (the example's is in
   // the source tree).
-  const fs::path err = fs::temp_directory_path() / ("trajroid_config_" + std::to_string(::getpid()) + "_" +
-                                                    config.filename().string() + ".err");
+  const fs::path err = fs::temp_directory_path() /
+                       ("trajroid_config_" + std::to_string(::getpid()) + "_" + config.filename().string() + ".err");
   const int code = daemon_test::run_command(std::string(TRAJROID) + " --config " + config.string() + " " + extra +
                                             " >/dev/null 2>" + err.string());
   return {code, daemon_test::slurp(err)};
@@ -99,8 +106,8 @@ TEST(DaemonConfig, TheDaemonExitsWith78OnABadConfigurationAndCheckConfigPassesAG
     EXPECT_NE(r.err.find("logging.level"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("loud"), std::string::npos) << r.err;
   }
-  const DaemonRun missing_trajectory =
-      trajroid(write("no_trajectory.yaml", replaced(example(), "file: trajectory.csv", "file: nowhere.csv")), "--check-config");
+  const DaemonRun missing_trajectory = trajroid(
+      write("no_trajectory.yaml", replaced(example(), "file: trajectory.csv", "file: nowhere.csv")), "--check-config");
   EXPECT_EQ(missing_trajectory.code, 78);
   EXPECT_NE(missing_trajectory.err.find("nowhere.csv"), std::string::npos) << missing_trajectory.err;
   std::ofstream(dir / "one_point.csv") << "1,1\n";

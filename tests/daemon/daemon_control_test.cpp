@@ -42,7 +42,8 @@ TEST(TrajroidControl, TrajectoryOverLcmSighupAndSigterm) {
   // Real-time pace: the run lasts 29 s, longer than the steps below need even under TSan.
   Child child({"--config", config.string(), "--replay", run.string(), "--rate", "1", "--lcm-url", kTestLcmUrl},
               run / (prefix + ".log"));
-  ASSERT_TRUE(listener.wait_for([&] { return !listener.points.empty(); }, seconds(20))) << slurp(run / (prefix + ".log"));
+  ASSERT_TRUE(listener.wait_for([&] { return !listener.points.empty(); }, seconds(20)))
+      << slurp(run / (prefix + ".log"));
 
   // Refused, each for its reason; the active trajectory stays.
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -69,15 +70,19 @@ TEST(TrajroidControl, TrajectoryOverLcmSighupAndSigterm) {
     const trajroi::roi_t& roi = listener.rois.at(first_new);
     EXPECT_EQ(roi.trajectory_id, 7);
     ASSERT_EQ(roi.num_centres, 6);  // 15 m look-ahead, d = 25 % of 12 m
-    for (const double cy : roi.cy) EXPECT_DOUBLE_EQ(cy, -6.0);
+    for (const double cy : roi.cy)
+      EXPECT_DOUBLE_EQ(cy, -6.0);
     // Before the swap, the configured trajectory; after it, only the new one.
-    for (const auto& [idx, m] : listener.points) EXPECT_EQ(m.trajectory_id, idx < first_new ? 0 : 7) << idx;
+    for (const auto& [idx, m] : listener.points)
+      EXPECT_EQ(m.trajectory_id, idx < first_new ? 0 : 7) << idx;
   }
 
   // SIGHUP: the configured file again, from a later sweep on.
   child.signal(SIGHUP);
   ASSERT_TRUE(listener.wait_for(
-      [&] { return listener.points.rbegin()->first > first_new && listener.points.rbegin()->second.trajectory_id == 0; },
+      [&] {
+        return listener.points.rbegin()->first > first_new && listener.points.rbegin()->second.trajectory_id == 0;
+      },
       seconds(10)));
 
   // Malformed files on SIGHUP: each refused with its reason in the log, the active
@@ -85,7 +90,8 @@ TEST(TrajroidControl, TrajectoryOverLcmSighupAndSigterm) {
   const std::string good = slurp(trajectory_file);
   std::string million;
   million.reserve(14'000'000);
-  for (int i = 0; i <= 1'000'000; ++i) million += std::to_string(i) + ",0\n";  // one too many
+  for (int i = 0; i <= 1'000'000; ++i)
+    million += std::to_string(i) + ",0\n";  // one too many
   const std::vector<std::pair<std::string, std::string>> bad{
       {"0,0\n5,nan\n10,0\n", ":2: waypoint is not finite"},
       {"0,0\n", "at least two distinct waypoints, got 1"},

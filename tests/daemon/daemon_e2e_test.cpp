@@ -32,7 +32,9 @@ fs::path write_config(const std::string& prefix, const std::string& pose_mode, c
   return file;
 }
 
-std::string unique_prefix(const char* name) { return "TRJTEST_" + std::to_string(::getpid()) + "_" + name; }
+std::string unique_prefix(const char* name) {
+  return "TRJTEST_" + std::to_string(::getpid()) + "_" + name;
+}
 
 // The capture decoded here, as trajroid's configuration asks (min 0.5 m, max 60 m).
 // The sensor pose a points_t publishes (the sweep's start).
@@ -78,15 +80,18 @@ std::vector<std::uint32_t> filter_keeps(const trajroi::vlp16::Frame& frame, cons
     std::fclose(f);
   }
   char chain[256];
-  std::snprintf(chain, sizeof chain, " --shape circular --diameter %.17g --spacing %.17g --start-s %.17g --look-ahead %.17g",
+  std::snprintf(chain, sizeof chain,
+                " --shape circular --diameter %.17g --spacing %.17g --start-s %.17g --look-ahead %.17g",
                 2.0 * roi.radius_m, roi.spacing_m, roi.start_s_m, roi.look_ahead_m);
-  const std::string cmd = std::string(TRAJROI_CLI) + " filter --trajectory " + (corridor_run() / "trajectory.csv").string() +
-                          " --points " + points.string() + " --pose " + pose + chain +
-                          " --cloud-precision float --output-indices " + indices.string() + " 2>/dev/null";
+  const std::string cmd = std::string(TRAJROI_CLI) + " filter --trajectory " +
+                          (corridor_run() / "trajectory.csv").string() + " --points " + points.string() + " --pose " +
+                          pose + chain + " --cloud-precision float --output-indices " + indices.string() +
+                          " 2>/dev/null";
   EXPECT_EQ(run_command(cmd), 0) << cmd;
   std::vector<std::uint32_t> kept;
   std::istringstream in(slurp(indices));
-  for (std::uint32_t i; in >> i;) kept.push_back(i);
+  for (std::uint32_t i; in >> i;)
+    kept.push_back(i);
   return kept;
 }
 
@@ -95,7 +100,8 @@ std::vector<std::uint32_t> daemon_keeps(const trajroi::vlp16::Frame& frame, cons
   std::map<std::tuple<std::int64_t, int, int>, std::uint32_t> index;
   for (std::uint32_t i = 0; i < frame.points.size(); ++i) {
     const auto& p = frame.points[i];
-    index[{static_cast<std::int64_t>(frame.start_time_ns) + p.time_offset_ns, p.ring, static_cast<int>(p.return_type)}] = i;
+    index[{static_cast<std::int64_t>(frame.start_time_ns) + p.time_offset_ns, p.ring,
+           static_cast<int>(p.return_type)}] = i;
   }
   std::vector<std::uint32_t> kept;
   for (std::size_t k = 0; k < static_cast<std::size_t>(m.num_points); ++k) {
@@ -136,8 +142,9 @@ struct Replay {
 // The listener must be subscribed before the replay starts; it keeps what it hears.
 Replay replay(const fs::path& config, const char* rate) {
   const fs::path err = config.parent_path() / (config.stem().string() + ".log");
-  Child child({"--config", config.string(), "--replay", corridor_run().string(), "--rate", rate, "--lcm-url", kTestLcmUrl},
-              err);
+  Child child(
+      {"--config", config.string(), "--replay", corridor_run().string(), "--rate", rate, "--lcm-url", kTestLcmUrl},
+      err);
   Replay r;
   r.exit_code = child.wait(seconds(180));
   std::this_thread::sleep_for(milliseconds(300));  // the last datagrams on their way
@@ -243,14 +250,17 @@ TEST(TrajroidEndToEnd, PerFiringMotionCompensationDiffersFromTheMidSweepPoseOnly
     ASSERT_NE(next, listener.points.end()) << "sweep " << m.sweep_index + 1;
     const Eigen::Isometry3d start = sensor_pose(m), end = sensor_pose(next->second);
     Eigen::Isometry3d middle = Eigen::Isometry3d::Identity();
-    middle.linear() = Eigen::Quaterniond(start.rotation()).slerp(0.5, Eigen::Quaterniond(end.rotation())).toRotationMatrix();
+    middle.linear() =
+        Eigen::Quaterniond(start.rotation()).slerp(0.5, Eigen::Quaterniond(end.rotation())).toRotationMatrix();
     middle.translation() = 0.5 * (start.translation() + end.translation());
-    const auto expected = filter_keeps(*frame, m, listener.rois.at(m.sweep_index), corridor_run(), pose_argument(middle));
+    const auto expected =
+        filter_keeps(*frame, m, listener.rois.at(m.sweep_index), corridor_run(), pose_argument(middle));
     ASSERT_TRUE(std::is_sorted(expected.begin(), expected.end()));
     auto got = daemon_keeps(*frame, m);
     std::sort(got.begin(), got.end());
     std::vector<std::uint32_t> symmetric;
-    std::set_symmetric_difference(got.begin(), got.end(), expected.begin(), expected.end(), std::back_inserter(symmetric));
+    std::set_symmetric_difference(got.begin(), got.end(), expected.begin(), expected.end(),
+                                  std::back_inserter(symmetric));
     ASSERT_GT(expected.size(), 1000u);
     EXPECT_LE(static_cast<double>(symmetric.size()) / static_cast<double>(expected.size()), 0.0025)
         << "sweep " << m.sweep_index << ": " << symmetric.size() << " of " << expected.size() << " differ";
@@ -363,7 +373,8 @@ TEST(TrajroidEndToEnd, SigtermInTheMiddleOfASweepAndARecordingLeavesACompleteRec
     trajroi::vlp16::Datagram d;
     std::size_t datagrams = 0;
     trajroi::vlp16::PacketSource::Next r;
-    while ((r = source.next(d)) == trajroi::vlp16::PacketSource::Next::kDatagram) ++datagrams;
+    while ((r = source.next(d)) == trajroi::vlp16::PacketSource::Next::kDatagram)
+      ++datagrams;
     EXPECT_EQ(r, trajroi::vlp16::PacketSource::Next::kEnd) << source.error();
     EXPECT_EQ(source.skipped_records(), 0u);
     EXPECT_GT(datagrams, 3000u) << "about 5 s of dual-return packets";

@@ -19,7 +19,9 @@ const fs::path& outage_run() {
   return dir;
 }
 
-bool under_sanitizer() { return std::getenv("TRAJROI_SANITIZER") != nullptr; }
+bool under_sanitizer() {
+  return std::getenv("TRAJROI_SANITIZER") != nullptr;
+}
 
 // One live test: its own channels, UDP ports and device links.
 void replace_once(std::string& text, const std::string& from, const std::string& to) {
@@ -50,8 +52,8 @@ struct LiveRig {
     // trajectory path is made absolute since this file lives elsewhere.
     replace_once(text, "file: trajectory.csv", "file: " + (run / "trajectory.csv").string());
     replace_once(text, "\nlidar:\n",
-                 "\nlidar:\n  data_port: " + std::to_string(data_port) + "\n  position_port: " +
-                     std::to_string(data_port + 1) + "\n" + extra_lidar);
+                 "\nlidar:\n  data_port: " + std::to_string(data_port) +
+                     "\n  position_port: " + std::to_string(data_port + 1) + "\n" + extra_lidar);
     replace_once(text, "\ngnss:\n", "\ngnss:\n  device: " + gnss_link.string() + "\n");
     replace_once(text, "\nimu:\n", "\nimu:\n  device: " + imu_link.string() + "\n");
     text += "lcm:\n  channels: {points: " + prefix + "_POINTS, pose: " + prefix + "_POSE, roi: " + prefix +
@@ -64,9 +66,18 @@ struct LiveRig {
     fs::remove_all(dir, ignored);
   }
   [[nodiscard]] std::vector<std::string> feed_args(const fs::path& run, std::vector<std::string> extra) const {
-    std::vector<std::string> a{"feed",        run.string(),      "--data-port", std::to_string(data_port),
-                               "--position-port", std::to_string(data_port + 1), "--gnss-link", gnss_link.string(),
-                               "--imu-link",  imu_link.string(), "--linger",    "5"};
+    std::vector<std::string> a{"feed",
+                               run.string(),
+                               "--data-port",
+                               std::to_string(data_port),
+                               "--position-port",
+                               std::to_string(data_port + 1),
+                               "--gnss-link",
+                               gnss_link.string(),
+                               "--imu-link",
+                               imu_link.string(),
+                               "--linger",
+                               "5"};
     a.insert(a.end(), extra.begin(), extra.end());
     return a;
   }
@@ -125,7 +136,8 @@ std::map<std::int64_t, double> sweep_times(Listener& listener) {
   std::map<std::int64_t, double> t;
   if (listener.poses.empty()) return t;
   const std::int64_t t0 = listener.poses.begin()->second.t_ns;
-  for (const auto& [idx, p] : listener.poses) t[idx] = static_cast<double>(p.t_ns - t0) * 1e-9;
+  for (const auto& [idx, p] : listener.poses)
+    t[idx] = static_cast<double>(p.t_ns - t0) * 1e-9;
   return t;
 }
 
@@ -270,10 +282,11 @@ TEST(TrajroidFaults, UdpFloodWithMalformedPacketsIsCountedBoundedAndRecoveredFro
   EXPECT_GE(last.decode_errors + oversize, malformed - lost);
   EXPECT_LE(counter(last, "lidar.duplicates"), flood - malformed);
   EXPECT_GE(counter(last, "lidar.duplicates"), flood - malformed - lost);
-  std::printf("flood: %lld datagrams (%lld malformed) beside %lld data packets; kernel drops %lld, ring drops %lld; "
-              "RSS %ld kB before, %ld kB peak\n",
-              static_cast<long long>(flood), static_cast<long long>(malformed), static_cast<long long>(data),
-              static_cast<long long>(kernel), static_cast<long long>(ring), before_kb, peak_kb);
+  std::printf(
+      "flood: %lld datagrams (%lld malformed) beside %lld data packets; kernel drops %lld, ring drops %lld; "
+      "RSS %ld kB before, %ld kB peak\n",
+      static_cast<long long>(flood), static_cast<long long>(malformed), static_cast<long long>(data),
+      static_cast<long long>(kernel), static_cast<long long>(ring), before_kb, peak_kb);
   // Resident memory: every buffer is preallocated, so the flood does not grow it. (ASan's
   // allocator quarantine grows on its own: not checked there.)
   ASSERT_GT(before_kb, 0);

@@ -22,13 +22,13 @@
 #include <thread>
 #include <vector>
 
+#include "trajroi/inputs/capture.hpp"
 #include "trajroi/points_t.hpp"
 #include "trajroi/pose_t.hpp"
 #include "trajroi/roi_t.hpp"
 #include "trajroi/status_t.hpp"
-#include "trajroi/transport/lcm_subscribe.hpp"
 #include "trajroi/trajectory_t.hpp"
-#include "trajroi/inputs/capture.hpp"
+#include "trajroi/transport/lcm_subscribe.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
 #include "trajroi/vlp16/stream_decoder.hpp"
 
@@ -54,13 +54,14 @@ inline int run_command(const std::string& command) {
 inline fs::path simulate(const std::string& scenario, const std::string& tag) {
   static std::vector<fs::path> made;
   const fs::path d = fs::temp_directory_path() / ("trajroid_test_" + tag + "_" + std::to_string(::getpid()));
-  const std::string cmd = std::string(TRAJROI_CLI) + " sim --quiet --scenario " + scenario + " --out " + d.string() +
-                          " >/dev/null";
+  const std::string cmd =
+      std::string(TRAJROI_CLI) + " sim --quiet --scenario " + scenario + " --out " + d.string() + " >/dev/null";
   if (run_command(cmd) != 0) throw std::runtime_error("cannot simulate the test scenario: " + cmd);
   if (made.empty()) {
     std::atexit([] {
       std::error_code ignored;
-      for (const fs::path& p : made) fs::remove_all(p, ignored);
+      for (const fs::path& p : made)
+        fs::remove_all(p, ignored);
     });
   }
   made.push_back(d);
@@ -87,7 +88,6 @@ inline std::vector<trajroi::vlp16::Frame> decode_capture(const fs::path& pcap) {
   trajroi::inputs::CaptureDecoder(source, decoder).run(sink);
   return std::move(sink.frames);
 }
-
 
 // A running trajroid (or, with `program`, another tool: its stdout goes to the file too).
 class Child {
@@ -135,11 +135,13 @@ class Child {
     if (pid_ == 0) {
       std::freopen(output_file.c_str(), "w", stderr);
       if (stdout_too) dup2(fileno(stderr), STDOUT_FILENO);
-      for (const std::string& e : environment) putenv(strdup(e.c_str()));
+      for (const std::string& e : environment)
+        putenv(strdup(e.c_str()));
       std::vector<std::string> copy = args;
       copy.insert(copy.begin(), program);
       std::vector<char*> argv;
-      for (std::string& a : copy) argv.push_back(a.data());
+      for (std::string& a : copy)
+        argv.push_back(a.data());
       argv.push_back(nullptr);
       execv(program.c_str(), argv.data());
       _exit(127);
@@ -160,7 +162,8 @@ class Listener {
     trajroi::transport::subscribe<&Listener::on_roi>(lcm_, prefix + "_ROI", this);
     trajroi::transport::subscribe<&Listener::on_status>(lcm_, prefix + "_STATUS", this);
     thread_ = std::thread([this] {
-      while (!stop_) lcm_.handleTimeout(20);
+      while (!stop_)
+        lcm_.handleTimeout(20);
     });
   }
   ~Listener() {

@@ -96,14 +96,16 @@ Supervision supervise(NotifySocket& notify, Child& child, Clock::duration limit)
   return s;
 }
 
-double seconds_of(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+double seconds_of(Clock::duration d) {
+  return std::chrono::duration<double>(d).count();
+}
 
 TEST(TrajroidWatchdog, AStuckProcessingThreadStopsTheWatchdogAndTheServiceIsRestarted) {
   NotifySocket notify;
   ASSERT_TRUE(notify.bound());
   const fs::path dir = corridor_run();
-  const std::vector<std::string> args{"--config", (dir / "trajroid.yaml").string(), "--replay", dir.string(),
-                                      "--rate", "1", "--lcm-url", kTestLcmUrl};
+  const std::vector<std::string> args{
+      "--config", (dir / "trajroid.yaml").string(), "--replay", dir.string(), "--rate", "1", "--lcm-url", kTestLcmUrl};
   const std::vector<std::string> env{notify.environment(), "WATCHDOG_USEC=" + std::to_string(kWatchdog.count() * 1000)};
   const fs::path log = fs::temp_directory_path() / ("trajroid_watchdog_" + std::to_string(::getpid()) + ".log");
 

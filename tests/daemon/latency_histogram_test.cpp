@@ -1,12 +1,12 @@
 // The whole-run latency histogram: quantiles against sorting the same values (to its 10 µs
 // bins), above-range values, and fixed memory whatever the count.
+#include "trajroi/daemon/latency_histogram.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <random>
 #include <vector>
-
-#include "trajroi/daemon/latency_histogram.hpp"
 
 namespace {
 

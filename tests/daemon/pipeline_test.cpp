@@ -2,6 +2,8 @@
 // as the daemon's merger orders them) and a fake outlet that keeps every published message.
 // No binary, no sockets, no LCM: the input threads, the processing thread and the publisher
 // run as in the daemon (run by the README's test command under ThreadSanitizer too).
+#include "pipeline.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,13 +13,12 @@
 
 #include "daemon_fixture.hpp"
 #include "outlet.hpp"
-#include "pipeline.hpp"
 #include "reload.hpp"
 #include "trajroi/daemon/config.hpp"
 #include "trajroi/daemon/sweep_processor.hpp"
 #include "trajroi/eval/scenario_eval.hpp"
-#include "trajroi/inputs/recorded_input.hpp"
 #include "trajroi/inputs/pacer.hpp"
+#include "trajroi/inputs/recorded_input.hpp"
 #include "trajroi/inputs/run_merger.hpp"
 #include "trajroi/points_t.hpp"
 #include "trajroi/status_t.hpp"
@@ -41,7 +42,8 @@ std::vector<Item> run_items(inputs::RunStreams streams) {
   std::vector<Item> out;
   inputs::RunMerger merger(corridor_run(), streams);
   inputs::InputItem item;
-  while (merger.next(item)) out.push_back({item.stream, item.receive_ns, {item.bytes.begin(), item.bytes.end()}});
+  while (merger.next(item))
+    out.push_back({item.stream, item.receive_ns, {item.bytes.begin(), item.bytes.end()}});
   return out;
 }
 
@@ -123,8 +125,12 @@ std::map<std::int64_t, std::size_t> reference_kept(const DaemonConfig& config) {
   SweepProcessor processor(config, trajroi::daemon::load_trajectory(config.trajectory_file));
   for (const Item& i : run_items({})) {
     switch (i.stream) {
-      case inputs::Stream::kGnss: processor.gnss_bytes(i.bytes, i.t_ns); break;
-      case inputs::Stream::kImu: processor.imu_bytes(i.bytes, i.t_ns); break;
+      case inputs::Stream::kGnss:
+        processor.gnss_bytes(i.bytes, i.t_ns);
+        break;
+      case inputs::Stream::kImu:
+        processor.imu_bytes(i.bytes, i.t_ns);
+        break;
       default:
         processor.lidar_datagram(i.stream == inputs::Stream::kLidarData ? trajroi::daemon::LidarPort::kData
                                                                         : trajroi::daemon::LidarPort::kPosition,

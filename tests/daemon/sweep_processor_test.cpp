@@ -1,6 +1,8 @@
 // SweepProcessor driven in process with the test scenario's recordings, merged by receive
 // time as trajroid's replay merges them: the speed growth of the ROI, the trajectory swap at
 // a sweep boundary, the pose gate without GNSS.
+#include "trajroi/daemon/sweep_processor.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,9 +11,8 @@
 
 #include "daemon_fixture.hpp"
 #include "trajroi/daemon/config.hpp"
-#include "trajroi/daemon/sweep_processor.hpp"
-#include "trajroi/roi/trajectory.hpp"
 #include "trajroi/inputs/run_merger.hpp"
+#include "trajroi/roi/trajectory.hpp"
 
 namespace {
 
@@ -48,10 +49,13 @@ const std::vector<Event>& run_events() {
   return events;
 }
 
-DaemonConfig run_config() { return trajroi::daemon::load_daemon_config(corridor_run() / "trajroid.yaml"); }
+DaemonConfig run_config() {
+  return trajroi::daemon::load_daemon_config(corridor_run() / "trajroid.yaml");
+}
 
 std::unique_ptr<ActiveTrajectory> trajectory_from(const fs::path& file, std::int32_t id) {
-  return std::make_unique<ActiveTrajectory>(ActiveTrajectory{trajroi::roi::parse_trajectory_csv(slurp(file), file.string()), id});
+  return std::make_unique<ActiveTrajectory>(
+      ActiveTrajectory{trajroi::roi::parse_trajectory_csv(slurp(file), file.string()), id});
 }
 
 struct Collect final : trajroi::daemon::SweepSink {
@@ -135,7 +139,8 @@ TEST(SweepProcessor, ATrajectoryOfferedInsideASweepTakesEffectAtTheNextOne) {
   {
     const trajroi::roi::Trajectory original = trajectory_from(config.trajectory_file, 0)->trajectory;
     std::FILE* f = std::fopen(shifted.c_str(), "w");
-    for (const auto& p : original.waypoints()) std::fprintf(f, "%.17g,%.17g\n", p.x(), p.y() + 1.0);
+    for (const auto& p : original.waypoints())
+      std::fprintf(f, "%.17g,%.17g\n", p.x(), p.y() + 1.0);
     std::fclose(f);
   }
   std::size_t offered_during = 0;
@@ -168,7 +173,8 @@ TEST(SweepProcessor, ATrajectoryOfferedInsideASweepTakesEffectAtTheNextOne) {
   ASSERT_FALSE(before.centres.empty());
   ASSERT_FALSE(after.centres.empty());
   EXPECT_NEAR(after.centres.front().position.y() - before.centres.front().position.y(), 1.0, 0.2);
-  for (std::size_t k = offered_during + 1; k < run.sweeps.size(); ++k) EXPECT_EQ(run.sweeps[k].trajectory_id, 9) << k;
+  for (std::size_t k = offered_during + 1; k < run.sweeps.size(); ++k)
+    EXPECT_EQ(run.sweeps[k].trajectory_id, 9) << k;
 }
 
 TEST(SweepProcessor, WithoutGnssNoSweepIsFilteredAndEachSaysWhy) {

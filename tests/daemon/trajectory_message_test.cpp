@@ -77,7 +77,8 @@ TEST(TrajectoryMessage, EachBadContentHasItsReason) {
   EXPECT_EQ(reason(nan), TrajectoryReject::kNonFinite);
   EXPECT_EQ(reason(line(1)), TrajectoryReject::kTooFewWaypoints);
   auto same = line(4);
-  for (auto& u : same.u) u = 2.0;
+  for (auto& u : same.u)
+    u = 2.0;
   EXPECT_EQ(reason(same), TrajectoryReject::kTooFewWaypoints);
   EXPECT_EQ(reason(line(5, 7)), TrajectoryReject::kBadCoordinates);
   auto north_of_pole = line(5, trajroi::trajectory_t::LAT_LON);

@@ -19,23 +19,22 @@ struct PaperRow {
 };
 
 // Table 3 (circular) and Table 5 (rectangular), straight data.
-constexpr PaperRow kStraightCircular[] = {
-    {150, 10, 6234, 0, 6197, 8020},  {125, 12, 7422, 0, 5009, 8020},  {100, 14, 9460, 0, 2971, 8020},
-    {75, 19, 10696, 0, 1735, 8020},  {50, 28, 11467, 0, 964, 8020},   {25, 56, 11683, 0, 748, 8020},
-    {10, 139, 11897, 0, 534, 8020}};
-constexpr PaperRow kStraightRectangular[] = {
-    {150, 19, 8525, 0, 3906, 8020}, {125, 23, 10137, 0, 2294, 8020}, {100, 28, 12431, 0, 0, 8020},
-    {75, 37, 12431, 0, 0, 8020},    {50, 56, 12431, 0, 0, 8020},     {25, 111, 12431, 0, 0, 8020},
-    {10, 277, 12431, 0, 0, 8020}};
+constexpr PaperRow kStraightCircular[] = {{150, 10, 6234, 0, 6197, 8020}, {125, 12, 7422, 0, 5009, 8020},
+                                          {100, 14, 9460, 0, 2971, 8020}, {75, 19, 10696, 0, 1735, 8020},
+                                          {50, 28, 11467, 0, 964, 8020},  {25, 56, 11683, 0, 748, 8020},
+                                          {10, 139, 11897, 0, 534, 8020}};
+constexpr PaperRow kStraightRectangular[] = {{150, 19, 8525, 0, 3906, 8020}, {125, 23, 10137, 0, 2294, 8020},
+                                             {100, 28, 12431, 0, 0, 8020},   {75, 37, 12431, 0, 0, 8020},
+                                             {50, 56, 12431, 0, 0, 8020},    {25, 111, 12431, 0, 0, 8020},
+                                             {10, 277, 12431, 0, 0, 8020}};
 // Curved data: the paper's #ROI and TP (FP and FN depend on its 11,804-point truth).
-constexpr PaperRow kCurvedCircular[] = {
-    {150, 10, 6060, 0, 5744, 7874},  {125, 11, 7435, 0, 4369, 7874}, {100, 14, 9288, 0, 2516, 7874},
-    {75, 19, 10560, 0, 1244, 7874},  {50, 28, 11287, 0, 517, 7874},  {25, 55, 11671, 0, 133, 7874},
-    {10, 136, 11777, 0, 27, 7874}};
+constexpr PaperRow kCurvedCircular[] = {{150, 10, 6060, 0, 5744, 7874}, {125, 11, 7435, 0, 4369, 7874},
+                                        {100, 14, 9288, 0, 2516, 7874}, {75, 19, 10560, 0, 1244, 7874},
+                                        {50, 28, 11287, 0, 517, 7874},  {25, 55, 11671, 0, 133, 7874},
+                                        {10, 136, 11777, 0, 27, 7874}};
 constexpr PaperRow kCurvedRectangular[] = {
-    {150, 19, 7883, 17, 0, 0},  {125, 22, 9434, 26, 0, 0},  {100, 28, 11621, 23, 0, 0},
-    {75, 37, 11791, 29, 0, 0},  {50, 55, 11799, 35, 0, 0},  {25, 109, 11799, 42, 0, 0},
-    {10, 272, 11802, 49, 0, 0}};
+    {150, 19, 7883, 17, 0, 0}, {125, 22, 9434, 26, 0, 0},  {100, 28, 11621, 23, 0, 0}, {75, 37, 11791, 29, 0, 0},
+    {50, 55, 11799, 35, 0, 0}, {25, 109, 11799, 42, 0, 0}, {10, 272, 11802, 49, 0, 0}};
 
 TEST(ArtificialScene, SizesAndTruthMatchTheSetUp) {
   const ArtificialScene straight = make_artificial_scene(ArtificialData::kStraight);
@@ -78,10 +77,18 @@ void expect_curved_rows_close(RoiShape shape, std::span<const PaperRow> rows) {
   }
 }
 
-TEST(PaperTable3, StraightCircularExact) { expect_straight_rows_exact(RoiShape::kCircular, kStraightCircular); }
-TEST(PaperTable5, StraightRectangularExact) { expect_straight_rows_exact(RoiShape::kRectangular, kStraightRectangular); }
-TEST(PaperTable3, CurvedCircularWithinPointOnePercent) { expect_curved_rows_close(RoiShape::kCircular, kCurvedCircular); }
-TEST(PaperTable5, CurvedRectangularWithinPointOnePercent) { expect_curved_rows_close(RoiShape::kRectangular, kCurvedRectangular); }
+TEST(PaperTable3, StraightCircularExact) {
+  expect_straight_rows_exact(RoiShape::kCircular, kStraightCircular);
+}
+TEST(PaperTable5, StraightRectangularExact) {
+  expect_straight_rows_exact(RoiShape::kRectangular, kStraightRectangular);
+}
+TEST(PaperTable3, CurvedCircularWithinPointOnePercent) {
+  expect_curved_rows_close(RoiShape::kCircular, kCurvedCircular);
+}
+TEST(PaperTable5, CurvedRectangularWithinPointOnePercent) {
+  expect_curved_rows_close(RoiShape::kRectangular, kCurvedRectangular);
+}
 
 TEST(ArtificialRow, TimingIsReported) {
   const ArtificialScene scene = make_artificial_scene(ArtificialData::kStraight);

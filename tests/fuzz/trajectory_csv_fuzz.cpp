@@ -9,7 +9,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
-    const trajroi::roi::Trajectory t = trajroi::roi::parse_trajectory_csv(trajroi::fuzz::as_text(data, size), "fuzz.csv");
+    const trajroi::roi::Trajectory t =
+        trajroi::roi::parse_trajectory_csv(trajroi::fuzz::as_text(data, size), "fuzz.csv");
     const double length = t.length_m();
     (void)t.point_at(length / 3.0);
     (void)t.heading_at(length / 2.0);

@@ -12,14 +12,18 @@ namespace trajroi::pose {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-constexpr double kA = 6378137.0;              // WGS84 semi-major axis
-constexpr double kF = 1.0 / 298.257223563;    // WGS84 flattening
+constexpr double kA = 6378137.0;            // WGS84 semi-major axis
+constexpr double kF = 1.0 / 298.257223563;  // WGS84 flattening
 constexpr double kE2 = kF * (2.0 - kF);
 
 // Meridional radius of curvature at latitude φ.
-double meridional_radius(double lat_rad) { return kA * (1.0 - kE2) / std::pow(1.0 - kE2 * std::sin(lat_rad) * std::sin(lat_rad), 1.5); }
+double meridional_radius(double lat_rad) {
+  return kA * (1.0 - kE2) / std::pow(1.0 - kE2 * std::sin(lat_rad) * std::sin(lat_rad), 1.5);
+}
 // Prime-vertical radius of curvature.
-double normal_radius(double lat_rad) { return kA / std::sqrt(1.0 - kE2 * std::sin(lat_rad) * std::sin(lat_rad)); }
+double normal_radius(double lat_rad) {
+  return kA / std::sqrt(1.0 - kE2 * std::sin(lat_rad) * std::sin(lat_rad));
+}
 
 TEST(Geodetic, OriginMapsToZero) {
   const Geodetic origin{48.7409646, 9.3117369, 315.3};
@@ -106,9 +110,15 @@ TEST(Geodetic, RejectsImpossibleConfiguration) {
 
 // ---- Attitude ---------------------------------------------------------------------------------
 
-Eigen::Vector3d forward(const Eigen::Quaterniond& q) { return q * Eigen::Vector3d::UnitX(); }
-Eigen::Vector3d left(const Eigen::Quaterniond& q) { return q * Eigen::Vector3d::UnitY(); }
-Eigen::Vector3d up(const Eigen::Quaterniond& q) { return q * Eigen::Vector3d::UnitZ(); }
+Eigen::Vector3d forward(const Eigen::Quaterniond& q) {
+  return q * Eigen::Vector3d::UnitX();
+}
+Eigen::Vector3d left(const Eigen::Quaterniond& q) {
+  return q * Eigen::Vector3d::UnitY();
+}
+Eigen::Vector3d up(const Eigen::Quaterniond& q) {
+  return q * Eigen::Vector3d::UnitZ();
+}
 
 TEST(Attitude, HeadingsAtTheFourCardinalPoints) {
   struct Case {
@@ -159,8 +169,8 @@ TEST(Attitude, FallbackHeadings) {
   const auto to_yaw = [](double bearing) { return enu_yaw_from_bearing_deg(bearing); };
   HeadingFallback cfg;
   cfg.min_speed_mps = 1.0;
-  EXPECT_FALSE(yaw_from_course(90.0, 0.5, 1.0, cfg, to_yaw).valid);  // too slow
-  EXPECT_FALSE(yaw_from_course(90.0, 2.0, 20.0, cfg, to_yaw).valid); // too uncertain
+  EXPECT_FALSE(yaw_from_course(90.0, 0.5, 1.0, cfg, to_yaw).valid);   // too slow
+  EXPECT_FALSE(yaw_from_course(90.0, 2.0, 20.0, cfg, to_yaw).valid);  // too uncertain
   const HeadingCandidate course = yaw_from_course(90.0, 2.0, 1.0, cfg, to_yaw);
   ASSERT_TRUE(course.valid);
   EXPECT_NEAR(course.yaw_rad, 0.0, 1e-12);
@@ -173,7 +183,9 @@ TEST(Attitude, FallbackHeadings) {
 
 // ---- Pose buffer ------------------------------------------------------------------------------
 
-FixQuality good() { return {3, true, 0.02, true, false}; }
+FixQuality good() {
+  return {3, true, 0.02, true, false};
+}
 
 GnssFix fix(std::int64_t t_ms, double x, double y, FixQuality q = good()) {
   return {t_ms * 1'000'000, Eigen::Vector3d(x, y, 0.0), q};
@@ -240,10 +252,11 @@ TEST(PoseBuffer, EveryGateNamesItsReason) {
   FixQuality rtk_float = good();
   rtk_float.rtk_fixed = false;
   rtk_float.rtk_float = true;
-  for (const Case& c : {Case{two_d, PoseGate{}, PoseStatus::kFixTypeTooLow}, Case{time_only, PoseGate{}, PoseStatus::kFixTypeTooLow},
-                        Case{not_ok, PoseGate{}, PoseStatus::kNoGnssFixOk}, Case{coarse, PoseGate{}, PoseStatus::kAccuracyTooLow},
-                        Case{rtk_float, rtk, PoseStatus::kNotRtkFixed}, Case{rtk_float, PoseGate{}, PoseStatus::kValid},
-                        Case{good(), rtk, PoseStatus::kValid}}) {
+  for (const Case& c :
+       {Case{two_d, PoseGate{}, PoseStatus::kFixTypeTooLow}, Case{time_only, PoseGate{}, PoseStatus::kFixTypeTooLow},
+        Case{not_ok, PoseGate{}, PoseStatus::kNoGnssFixOk}, Case{coarse, PoseGate{}, PoseStatus::kAccuracyTooLow},
+        Case{rtk_float, rtk, PoseStatus::kNotRtkFixed}, Case{rtk_float, PoseGate{}, PoseStatus::kValid},
+        Case{good(), rtk, PoseStatus::kValid}}) {
     PoseBuffer buf(c.gate, Eigen::Vector3d::Zero());
     ASSERT_TRUE(buf.add_fix(fix(0, 0.0, 0.0, c.quality)));
     ASSERT_TRUE(buf.add_attitude(yaw_at(0, 0.0)));
@@ -279,7 +292,8 @@ TEST(PoseBuffer, GapsEmptyBuffersAndOrdering) {
   EXPECT_EQ(buf.counters().out_of_order, 2U);
   EXPECT_EQ(buf.counters().non_finite, 1U);
   // Capacity 4: the oldest samples go first.
-  for (int i = 4; i < 10; ++i) ASSERT_TRUE(buf.add_fix(fix(1000 * i, 0.0, 0.0)));
+  for (int i = 4; i < 10; ++i)
+    ASSERT_TRUE(buf.add_fix(fix(1000 * i, 0.0, 0.0)));
   ASSERT_TRUE(buf.add_attitude(yaw_at(9000, 0.0)));
   EXPECT_EQ(buf.pose_at(3'500'000'000).status, PoseStatus::kBeforeFirstSample);
   EXPECT_THROW(PoseBuffer(PoseGate{}, Eigen::Vector3d::Zero(), 1), std::invalid_argument);

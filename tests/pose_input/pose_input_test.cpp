@@ -15,12 +15,12 @@ namespace {
 
 TEST(ClockMap, TakesTheLeastDelayAndResetsOnAJump) {
   ClockMap clock(1'000'000'000);
-  EXPECT_EQ(clock.map(1'000, 5'000), 5'000);      // offset 4000
-  EXPECT_EQ(clock.map(2'000, 6'500), 6'000);      // 4500 > 4000: jitter ignored
-  EXPECT_EQ(clock.map(3'000, 6'800), 6'800);      // offset 3800: the new floor
+  EXPECT_EQ(clock.map(1'000, 5'000), 5'000);  // offset 4000
+  EXPECT_EQ(clock.map(2'000, 6'500), 6'000);  // 4500 > 4000: jitter ignored
+  EXPECT_EQ(clock.map(3'000, 6'800), 6'800);  // offset 3800: the new floor
   EXPECT_EQ(clock.map(4'000, 8'000), 7'800);
   EXPECT_EQ(clock.resets(), 0u);
-  EXPECT_EQ(clock.map(1'000, 9'000), 9'000);      // sensor time went backwards
+  EXPECT_EQ(clock.map(1'000, 9'000), 9'000);  // sensor time went backwards
   EXPECT_EQ(clock.resets(), 1u);
   EXPECT_EQ(clock.map(2'000, 3'000'000'000), 3'000'000'000);  // host jumped by 3 s
   EXPECT_EQ(clock.resets(), 2u);

@@ -26,8 +26,12 @@ void* operator new(std::size_t size) {
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
   throw std::bad_alloc();
 }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
 
 namespace trajroi::roi {
 namespace {
@@ -57,9 +61,11 @@ TEST(Allocation, WarmFilterCallsAllocateNothing) {
     reference_filter(rects, std::span<const PointXYZI>(global), kept);
   };
   // warm-up: one pass over the frames lets every buffer reach its working size
-  for (int k = 0; k < 20; ++k) frame(0.05 * k);
+  for (int k = 0; k < 20; ++k)
+    frame(0.05 * k);
   const std::size_t before = g_allocations.load();
-  for (int k = 0; k < 20; ++k) frame(0.05 * k);
+  for (int k = 0; k < 20; ++k)
+    frame(0.05 * k);
   EXPECT_EQ(g_allocations.load() - before, 0u);
   EXPECT_GT(kept.size(), 0u);
 }

@@ -14,10 +14,10 @@ namespace {
 TEST(Cuboid, OrientedWithTheRobot) {
   // Robot at (10, 0) facing +y; box 20 m long, 4 m wide, z in [−1, 3].
   const CuboidRoi box(pose_from_xy_yaw(10, 0, std::numbers::pi / 2), centred_cuboid(20, 4, -1, 3));
-  EXPECT_TRUE(box.contains(10, 9.9, 0));    // 9.9 m ahead
+  EXPECT_TRUE(box.contains(10, 9.9, 0));  // 9.9 m ahead
   EXPECT_FALSE(box.contains(10, 10.1, 0));
-  EXPECT_TRUE(box.contains(11.9, -9, 0));   // 1.9 m to the right, 9 m behind
-  EXPECT_FALSE(box.contains(12.1, 0, 0));   // 2.1 m to the right
+  EXPECT_TRUE(box.contains(11.9, -9, 0));  // 1.9 m to the right, 9 m behind
+  EXPECT_FALSE(box.contains(12.1, 0, 0));  // 2.1 m to the right
   EXPECT_FALSE(box.contains(10, 0, 3.1));
   EXPECT_TRUE(box.contains(10, 0, -1));
 }

@@ -73,8 +73,8 @@ Trajectory random_trajectory(PathKind kind, std::mt19937_64& rng) {
 // random ROI as computed in double (a circle's rim, a rectangle's side or corner, a capsule's
 // rim), and a third within 20 µm of such an edge.
 template <typename Point>
-std::vector<Point> random_points(const Trajectory& t, std::span<const Centre> centres,
-                                 double reach, std::mt19937_64& rng, auto edge_point) {
+std::vector<Point> random_points(const Trajectory& t, std::span<const Centre> centres, double reach,
+                                 std::mt19937_64& rng, auto edge_point) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::uniform_real_distribution<double> jitter(-20e-6, 20e-6);
   double x_min = kInf, y_min = kInf, x_max = -kInf, y_max = -kInf;
@@ -89,8 +89,7 @@ std::vector<Point> random_points(const Trajectory& t, std::span<const Centre> ce
   for (int i = 0; i < kPointsPerTrajectory; ++i) {
     V p;
     if (i % 3 == 0) {
-      p = V(x_min - reach + (x_max - x_min + 2 * reach) * u(rng),
-            y_min - reach + (y_max - y_min + 2 * reach) * u(rng));
+      p = V(x_min - reach + (x_max - x_min + 2 * reach) * u(rng), y_min - reach + (y_max - y_min + 2 * reach) * u(rng));
     } else {
       const Centre& c = centres[std::uniform_int_distribution<std::size_t>(0, centres.size() - 1)(rng)];
       p = edge_point(c, u(rng), u(rng));
@@ -114,16 +113,15 @@ struct Totals {
 };
 
 template <typename RoiSet, typename Point>
-void expect_equal(const RoiSet& set, const std::vector<Point>& points, Totals& totals,
-                  const std::string& label) {
+void expect_equal(const RoiSet& set, const std::vector<Point>& points, Totals& totals, const std::string& label) {
   IndexVector ref;
   IndexVector fast;
   reference_filter(set, std::span<const Point>(points), ref);
   GridFilter<RoiSet> grid;
   grid.build(set);
   // Float clouds have vector scans; each must agree with the reference on its own.
-  for (const SimdPath path : {SimdPath::kAuto, SimdPath::kAvx512, SimdPath::kAvx2, SimdPath::kSse2,
-                              SimdPath::kScalar}) {
+  for (const SimdPath path :
+       {SimdPath::kAuto, SimdPath::kAvx512, SimdPath::kAvx2, SimdPath::kSse2, SimdPath::kScalar}) {
     grid.filter(std::span<const Point>(points), fast, path);
     ASSERT_EQ(ref.size(), fast.size()) << label << " path " << static_cast<int>(path);
     ASSERT_EQ(ref, fast) << label << " path " << static_cast<int>(path);
@@ -133,7 +131,9 @@ void expect_equal(const RoiSet& set, const std::vector<Point>& points, Totals& t
   ++totals.trajectories;
 }
 
-PathKind kind_of(int i) { return static_cast<PathKind>(i % 4); }
+PathKind kind_of(int i) {
+  return static_cast<PathKind>(i % 4);
+}
 
 template <typename Point>
 void run_property(const char* shape, std::uint64_t seed) {
@@ -187,15 +187,25 @@ void run_property(const char* shape, std::uint64_t seed) {
   // Not a vacuous comparison: a good share of points is kept, a good share is not.
   EXPECT_GT(totals.kept, totals.points / 10);
   EXPECT_LT(totals.kept, totals.points * 9 / 10);
-  std::printf("[ property ] %s: %zu points over %zu trajectories, %zu kept, fast == reference\n", shape,
-              totals.points, totals.trajectories, totals.kept);
+  std::printf("[ property ] %s: %zu points over %zu trajectories, %zu kept, fast == reference\n", shape, totals.points,
+              totals.trajectories, totals.kept);
 }
 
-TEST(FastEqualsReference, CircularDoublePoints) { run_property<PointXYZd>("circular", 1); }
-TEST(FastEqualsReference, RectangularDoublePoints) { run_property<PointXYZd>("rectangular", 2); }
-TEST(FastEqualsReference, CorridorDoublePoints) { run_property<PointXYZd>("corridor", 3); }
-TEST(FastEqualsReference, CircularFloatPoints) { run_property<PointXYZI>("circular", 4); }
-TEST(FastEqualsReference, RectangularFloatPoints) { run_property<PointXYZI>("rectangular", 5); }
+TEST(FastEqualsReference, CircularDoublePoints) {
+  run_property<PointXYZd>("circular", 1);
+}
+TEST(FastEqualsReference, RectangularDoublePoints) {
+  run_property<PointXYZd>("rectangular", 2);
+}
+TEST(FastEqualsReference, CorridorDoublePoints) {
+  run_property<PointXYZd>("corridor", 3);
+}
+TEST(FastEqualsReference, CircularFloatPoints) {
+  run_property<PointXYZI>("circular", 4);
+}
+TEST(FastEqualsReference, RectangularFloatPoints) {
+  run_property<PointXYZI>("rectangular", 5);
+}
 
 }  // namespace
 }  // namespace trajroi::roi

@@ -13,7 +13,6 @@ namespace {
 
 using V = Eigen::Vector2d;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 
 // The same checks for every ROI method (TEST_P over shapes).
 enum class Kind { kCircular, kRectangular, kCorridor };
@@ -45,9 +44,15 @@ class FilterBehaviour : public ::testing::TestWithParam<Kind> {
       fast_stats = grid.filter(points, fast);
     };
     switch (GetParam()) {
-      case Kind::kCircular: both(CircularRoiSet(2.0, centres, z)); break;
-      case Kind::kRectangular: both(RectangularRoiSet(2.0, 4.0, centres, z)); break;
-      case Kind::kCorridor: both(CorridorRoiSet(trajectory_, 0.0, kInf, 4.0, z)); break;
+      case Kind::kCircular:
+        both(CircularRoiSet(2.0, centres, z));
+        break;
+      case Kind::kRectangular:
+        both(RectangularRoiSet(2.0, 4.0, centres, z));
+        break;
+      case Kind::kCorridor:
+        both(CorridorRoiSet(trajectory_, 0.0, kInf, 4.0, z));
+        break;
     }
     EXPECT_EQ(ref, fast);
     EXPECT_EQ(ref_stats.kept, fast_stats.kept);
@@ -124,9 +129,12 @@ INSTANTIATE_TEST_SUITE_P(AllShapes, FilterBehaviour,
                          ::testing::Values(Kind::kCircular, Kind::kRectangular, Kind::kCorridor),
                          [](const ::testing::TestParamInfo<Kind>& param_info) {
                            switch (param_info.param) {
-                             case Kind::kCircular: return std::string("circular");
-                             case Kind::kRectangular: return std::string("rectangular");
-                             case Kind::kCorridor: return std::string("corridor");
+                             case Kind::kCircular:
+                               return std::string("circular");
+                             case Kind::kRectangular:
+                               return std::string("rectangular");
+                             case Kind::kCorridor:
+                               return std::string("corridor");
                            }
                            return std::string("unknown");
                          });
@@ -146,7 +154,8 @@ TEST(GridFilter, VectorScansApplyZLimitsLikeTheDoubleTest) {
     const float edge = edges[i % 2];
     const float towards = (i / 2) % 2 == 0 ? -kInf : kInf;
     float value = edge;
-    for (int k = 0; k < (i / 4) % 3; ++k) value = std::nextafter(value, towards);
+    for (int k = 0; k < (i / 4) % 3; ++k)
+      value = std::nextafter(value, towards);
     points.push_back({static_cast<float>(i % 20), 0.5f, value, 1.0f});
   }
   IndexVector ref;

@@ -1,8 +1,9 @@
 #include "trajroi/roi/metrics.hpp"
-#include "trajroi/roi/filter_stats.hpp"
-#include "trajroi/roi/point.hpp"
 
 #include <gtest/gtest.h>
+
+#include "trajroi/roi/filter_stats.hpp"
+#include "trajroi/roi/point.hpp"
 
 namespace trajroi::roi {
 namespace {

@@ -50,7 +50,7 @@ TEST(Rect, HeightRunsAlongTheTangentWidthAcross) {
   EXPECT_FALSE(rect_contains(g, 5 + 4.1, 5));
   // θ = 45°: the corner direction of a square is at 0° or 90° from the axes
   const RectGeometry d = make_rect_geometry(0, 0, std::numbers::pi / 4, 2, 2);
-  EXPECT_TRUE(rect_contains(d, 0.0, 1.4));   // along the diagonal: √2 reach
+  EXPECT_TRUE(rect_contains(d, 0.0, 1.4));  // along the diagonal: √2 reach
   EXPECT_FALSE(rect_contains(d, 0.0, 1.42));
   EXPECT_FALSE(rect_contains(d, std::nan(""), 0));
 }
@@ -76,14 +76,14 @@ TEST(Corridor, CoversTheSubPolylineBetweenS0AndS1) {
       if (c.contains(j, x, y)) return true;
     return false;
   };
-  EXPECT_TRUE(inside(5, 1));      // start, on the edge
-  EXPECT_TRUE(inside(4, 0));      // within w/2 of the start point (round cap)
-  EXPECT_FALSE(inside(3.9, 0));   // before s0
+  EXPECT_TRUE(inside(5, 1));     // start, on the edge
+  EXPECT_TRUE(inside(4, 0));     // within w/2 of the start point (round cap)
+  EXPECT_FALSE(inside(3.9, 0));  // before s0
   EXPECT_TRUE(inside(11, 5));
   EXPECT_TRUE(inside(10, 6));     // the end cap at (10, 5)
   EXPECT_FALSE(inside(10, 6.1));  // past s1
   EXPECT_FALSE(inside(7, 1.01));
-  EXPECT_EQ(c.size(), 2u);        // (5,0)→(10,0)→(10,5)
+  EXPECT_EQ(c.size(), 2u);  // (5,0)→(10,0)→(10,5)
 }
 
 TEST(CellRelation, IsConservative) {

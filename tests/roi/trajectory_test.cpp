@@ -107,8 +107,7 @@ TEST(Trajectory, HintOnASelfCrossingPath) {
 }
 
 TEST(TrajectoryCsv, ParsesCommentsBlankLinesAndCrlf) {
-  const Trajectory t =
-      parse_trajectory_csv("# header\n0,0\r\n\n  10 , 0  # inline\n10,+10\n", "t.csv");
+  const Trajectory t = parse_trajectory_csv("# header\n0,0\r\n\n  10 , 0  # inline\n10,+10\n", "t.csv");
   ASSERT_EQ(t.waypoints().size(), 3u);
   EXPECT_EQ(t.waypoints()[2], V(10, 10));
 }
@@ -118,11 +117,10 @@ TEST(TrajectoryCsv, ErrorsNameFileAndLine) {
     const char* text;
     const char* expected;
   };
-  for (const Case& c : {Case{"0,0\n1,1\nabc\n", "t.csv:3:"}, Case{"0,0\n1\n", "t.csv:2:"},
-                        Case{"0,0\n1,2,3\n", "t.csv:2:"}, Case{"0,0\n1,2x\n", "t.csv:2:"},
-                        Case{"0,0\n,2\n", "t.csv:2:"}, Case{"0,0\nnan,1\n", "t.csv:2:"},
-                        Case{"0,0\n", "t.csv: trajectory needs at least two"},
-                        Case{"", "t.csv: trajectory needs at least two"}}) {
+  for (const Case& c :
+       {Case{"0,0\n1,1\nabc\n", "t.csv:3:"}, Case{"0,0\n1\n", "t.csv:2:"}, Case{"0,0\n1,2,3\n", "t.csv:2:"},
+        Case{"0,0\n1,2x\n", "t.csv:2:"}, Case{"0,0\n,2\n", "t.csv:2:"}, Case{"0,0\nnan,1\n", "t.csv:2:"},
+        Case{"0,0\n", "t.csv: trajectory needs at least two"}, Case{"", "t.csv: trajectory needs at least two"}}) {
     try {
       (void)parse_trajectory_csv(c.text, "t.csv");
       FAIL() << "accepted: " << c.text;

@@ -2,9 +2,9 @@
 // (Section III-B): generated, decoded with the project's drivers, evaluated at the paper's
 // keyframes. Release builds only (about 15 s); the README's tables come from the same run.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
-#include <unistd.h>
 
 #include "test_data.hpp"
 #include "trajroi/eval/scenario_eval.hpp"
@@ -15,7 +15,8 @@ namespace {
 
 TEST(FactoryScenario, ReproducesThePapersKeyframeFindings) {
   const std::filesystem::path scenario_file = std::string(TRAJROI_SOURCE_DIR) + "/config/scenarios/factory.yaml";
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("trajroi_factory_" + std::to_string(::getpid()));
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("trajroi_factory_" + std::to_string(::getpid()));
   const std::string text = test::read_file(scenario_file);
   const RunReport report = write_run(load_scenario(scenario_file), text, dir);
   EXPECT_GT(report.realtime_factor(), 1.0);  // faster than real time

@@ -82,7 +82,8 @@ TEST(Scenario, UnknownKeyIsNamedWithFileAndLine) {
 }
 
 TEST(Scenario, MissingFieldIsNamed) {
-  const std::string e = error_of(replaced(kMinimal, "origin: {lat_deg: 36.0, lon_deg: 127.0}", "origin: {lat_deg: 36.0}"));
+  const std::string e =
+      error_of(replaced(kMinimal, "origin: {lat_deg: 36.0, lon_deg: 127.0}", "origin: {lat_deg: 36.0}"));
   EXPECT_NE(e.find("bad.yaml:3: origin.lon_deg: missing"), std::string::npos) << e;
   EXPECT_NE(error_of(replaced(kMinimal, "name: tiny\n", "")).find("name: missing"), std::string::npos);
 }
@@ -96,17 +97,20 @@ TEST(Scenario, ImpossibleValuesAreRefused) {
   EXPECT_NE(below.find("robot.lidar_mount.xyz: the sensor must be above the ground"), std::string::npos) << below;
   EXPECT_NE(error_of(kMinimal + "lidar: {rpm: 50}\n").find("lidar.rpm: must be 300"), std::string::npos);
   EXPECT_NE(error_of(kMinimal + "lidar: {max_range_m: 200}\n").find("lidar.max_range_m"), std::string::npos);
-  EXPECT_NE(error_of(kMinimal + "lidar: {return_mode: triple}\n").find("lidar.return_mode: must be one of strongest last dual"),
+  EXPECT_NE(error_of(kMinimal + "lidar: {return_mode: triple}\n")
+                .find("lidar.return_mode: must be one of strongest last dual"),
             std::string::npos);
   EXPECT_NE(error_of(kMinimal + "gnss: {rate_hz: 25, baud: 9600}\n").find("gnss.baud: too slow"), std::string::npos);
   EXPECT_NE(error_of(kMinimal + "gnss:\n  faults:\n    - {kind: lost, from_s: 5, to_s: 4}\n")
                 .find("gnss.faults[0].to_s: must be after from_s"),
             std::string::npos);
-  EXPECT_NE(error_of(replaced(kMinimal, "line: 2", "line: abc")).find("trajectory.segments[0].line: must be a finite number"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(replaced(kMinimal, "line: 2", "line: abc")).find("trajectory.segments[0].line: must be a finite number"),
+      std::string::npos);
   EXPECT_NE(error_of(replaced(kMinimal, "2024-05-14T09:00:00Z", "2024-02-30T09:00:00Z")).find("start_utc"),
             std::string::npos);
-  EXPECT_NE(error_of(replaced(kMinimal, "line: 2", "arc: {radius: 3, turn_deg: 0}")).find("turn_deg"), std::string::npos);
+  EXPECT_NE(error_of(replaced(kMinimal, "line: 2", "arc: {radius: 3, turn_deg: 0}")).find("turn_deg"),
+            std::string::npos);
   EXPECT_NE(error_of("- just\n- a list\n").find("bad.yaml: the top level must be a mapping"), std::string::npos);
   EXPECT_NE(error_of("name: [unclosed\n").find("bad.yaml:"), std::string::npos);
 }

@@ -63,8 +63,12 @@ class MemorySink final : public SimulationSink {
   void lidar_datagram(std::int64_t t, std::uint16_t port, std::span<const std::uint8_t> p) override {
     c.lidar.push_back({t, port, {p.begin(), p.end()}});
   }
-  void gnss_chunk(std::int64_t t, std::span<const std::uint8_t> b) override { c.gnss.emplace_back(t, std::vector(b.begin(), b.end())); }
-  void imu_chunk(std::int64_t t, std::span<const std::uint8_t> b) override { c.imu.emplace_back(t, std::vector(b.begin(), b.end())); }
+  void gnss_chunk(std::int64_t t, std::span<const std::uint8_t> b) override {
+    c.gnss.emplace_back(t, std::vector(b.begin(), b.end()));
+  }
+  void imu_chunk(std::int64_t t, std::span<const std::uint8_t> b) override {
+    c.imu.emplace_back(t, std::vector(b.begin(), b.end()));
+  }
   void firing_pose(const TruePose& p) override { c.poses.push_back(p); }
   void point_labels(std::span<const std::uint8_t> l) override { c.labels.insert(c.labels.end(), l.begin(), l.end()); }
 };
@@ -109,7 +113,8 @@ TEST(Simulator, WallAtKnownDistanceGivesTheManualsRangesAndTimes) {
       const double y_at_wall = range_to_wall * std::cos(omega) * std::sin(theta);
       if (range_to_ground < range_to_wall || z_at_wall > 20.0 || std::abs(y_at_wall) > 29.95) continue;
       // 2 mm range units; 1 µm of time rounding in the timestamps is far below that.
-      ASSERT_NEAR(static_cast<double>(p.distance_m), range_to_wall, 0.0011) << "packet " << packet << " laser " << int(p.laser);
+      ASSERT_NEAR(static_cast<double>(p.distance_m), range_to_wall, 0.0011)
+          << "packet " << packet << " laser " << int(p.laser);
       ASSERT_EQ(p.intensity, 90);
       ++wall_points;
     }
@@ -149,7 +154,10 @@ TEST(Simulator, SerialStreamsCarryTheTruePose) {
   ublox::Framer framer;
   std::size_t pvts = 0;
   std::int64_t last_pvt_t = 0;
-  for (const auto& [t, bytes] : sink.c.gnss) {
+  for (const auto& chunk : sink.c.gnss) {
+    // Named copies: clang 14 cannot capture structured bindings in the lambda.
+    const auto t = chunk.first;
+    const auto& bytes = chunk.second;
     framer.feed(bytes, [&](const ublox::Message& m) {
       if (m.msg_id != ublox::kIdNavPvt) return;
       const auto d = ublox::decode_nav_pvt(m.payload);
@@ -223,7 +231,8 @@ evaluation:
 class RunFolder : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new std::filesystem::path(std::filesystem::temp_directory_path() / ("trajroi_sim_test_" + std::to_string(::getpid())));
+    dir_ = new std::filesystem::path(std::filesystem::temp_directory_path() /
+                                     ("trajroi_sim_test_" + std::to_string(::getpid())));
     const Scenario s = parse_scenario(kDriveScenario, "drive.yaml");
     report_ = new RunReport(write_run(s, kDriveScenario, *dir_));
   }
@@ -303,7 +312,8 @@ TEST_F(RunFolder, KeyframeEvaluationRuns) {
   const eval::ScenarioRun run(*dir_);
   const auto cases = eval::keyframe_cases(run, eval::PoseMode::kPerFiring);
   ASSERT_EQ(cases.size(), 1u);
-  const eval::KeyframeRow row = eval::run_keyframe_row(run, cases[0], eval::RoiShape::kCircular, 25, 2, eval::PoseMode::kPerFiring);
+  const eval::KeyframeRow row =
+      eval::run_keyframe_row(run, cases[0], eval::RoiShape::kCircular, 25, 2, eval::PoseMode::kPerFiring);
   EXPECT_EQ(row.confusion.total(), cases[0].points.size());
   EXPECT_GT(row.confusion.tp, 1000u);
   EXPECT_GT(row.confusion.recall(), 0.95);

@@ -95,7 +95,8 @@ double brute_force(const WorldSpec& spec, const Eigen::Vector3d& o, const Eigen:
   double best = std::numeric_limits<double>::infinity();
   for (const Box& b : spec.boxes) {
     const double c = std::cos(b.yaw_rad), s = std::sin(b.yaw_rad);
-    const Eigen::Vector3d lo(-b.size_m.x() / 2, -b.size_m.y() / 2, 0.0), hi(b.size_m.x() / 2, b.size_m.y() / 2, b.height_m);
+    const Eigen::Vector3d lo(-b.size_m.x() / 2, -b.size_m.y() / 2, 0.0),
+        hi(b.size_m.x() / 2, b.size_m.y() / 2, b.height_m);
     const Eigen::Vector3d ol(c * (o.x() - b.centre_m.x()) + s * (o.y() - b.centre_m.y()),
                              -s * (o.x() - b.centre_m.x()) + c * (o.y() - b.centre_m.y()), o.z());
     const Eigen::Vector3d dl(c * d.x() + s * d.y(), -s * d.x() + c * d.y(), d.z());
@@ -109,7 +110,8 @@ double brute_force(const WorldSpec& spec, const Eigen::Vector3d& o, const Eigen:
   }
   for (const Cylinder& cy : spec.cylinders) {
     const double ox = o.x() - cy.centre_m.x(), oy = o.y() - cy.centre_m.y();
-    const double a = d.x() * d.x() + d.y() * d.y(), b = ox * d.x() + oy * d.y(), k = ox * ox + oy * oy - cy.radius_m * cy.radius_m;
+    const double a = d.x() * d.x() + d.y() * d.y(), b = ox * d.x() + oy * d.y(),
+                 k = ox * ox + oy * oy - cy.radius_m * cy.radius_m;
     const double disc = b * b - a * k;
     if (disc < 0) continue;
     double t0 = (-b - std::sqrt(disc)) / a, t1 = (-b + std::sqrt(disc)) / a;
@@ -126,8 +128,10 @@ TEST(World, GridWalkAgreesWithBruteForce) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> pos(-40, 40), size(0.2, 6), height(0.5, 8), yaw(0, 180), unit(-1, 1);
   WorldSpec spec;
-  for (int i = 0; i < 60; ++i) spec.boxes.push_back(box(pos(rng), pos(rng), size(rng), size(rng), height(rng), yaw(rng)));
-  for (int i = 0; i < 40; ++i) spec.cylinders.push_back(cylinder(pos(rng), pos(rng), size(rng) / 4, height(rng)));
+  for (int i = 0; i < 60; ++i)
+    spec.boxes.push_back(box(pos(rng), pos(rng), size(rng), size(rng), height(rng), yaw(rng)));
+  for (int i = 0; i < 40; ++i)
+    spec.cylinders.push_back(cylinder(pos(rng), pos(rng), size(rng) / 4, height(rng)));
   const World world(spec, 1.0);
   int hits = 0;
   for (int i = 0; i < 20000; ++i) {

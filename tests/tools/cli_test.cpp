@@ -23,8 +23,8 @@ TEST_F(Cli, FilterAppliesThePoseAndKeepsTheRightIndices) {
   const fs::path out = dir_ / "kept.txt";
   for (const char* algorithm : {"reference", "fast"}) {
     const CommandResult r = run("filter --trajectory " + traj.string() + " --points " + pts.string() +
-                      " --shape circular --diameter 6 --spacing 1 --pose 5,0,90 --algorithm " + algorithm +
-                      " --output-indices " + out.string());
+                                " --shape circular --diameter 6 --spacing 1 --pose 5,0,90 --algorithm " + algorithm +
+                                " --output-indices " + out.string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(slurp(out), "0\n1\n3\n") << algorithm;
     EXPECT_NE(r.err.find("1 non-finite"), std::string::npos) << r.err;
@@ -35,8 +35,9 @@ TEST_F(Cli, FilterRectangleCorridorAndCuboid) {
   const fs::path traj = write("t.csv", "0,0\n10,0\n10,10\n");
   const fs::path pts = write("p.csv", "5,0.9,0\n5,1.1,0\n11.2,5,0\n-0.4,0,0\n10.9,10.9,0\n");
   const fs::path out = dir_ / "kept.txt";
-  CommandResult r = run("filter --trajectory " + traj.string() + " --points " + pts.string() +
-              " --shape rectangular --height 1 --width 2 --spacing-ratio 0.5 --output-indices " + out.string());
+  CommandResult r =
+      run("filter --trajectory " + traj.string() + " --points " + pts.string() +
+          " --shape rectangular --height 1 --width 2 --spacing-ratio 0.5 --output-indices " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(slurp(out), "0\n3\n");  // (11.2,5) is 1.2 m across, (10.9,10.9) 0.9 m past the end (a/2 = 0.5)
   r = run("filter --trajectory " + traj.string() + " --points " + pts.string() +
@@ -54,7 +55,7 @@ TEST_F(Cli, MalformedPointsNameFileAndLineAndWriteNothing) {
   const fs::path pts = write("p.csv", "1,0,0\n2,0,0\n3,zero,0\n");
   const fs::path out = dir_ / "kept.txt";
   const CommandResult r = run("filter --trajectory " + traj.string() + " --points " + pts.string() +
-                    " --shape circular --diameter 6 --spacing 1 --output-indices " + out.string());
+                              " --shape circular --diameter 6 --spacing 1 --output-indices " + out.string());
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find(pts.string() + ":3:"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
@@ -68,17 +69,18 @@ TEST_F(Cli, BadTrajectoryAndBadSizesAreClearErrors) {
     std::string args;
     std::string expected;
   };
-  for (const Case& c : {Case{"0,0\n0,0\n", "--shape circular --diameter 6 --spacing 1", "at least two distinct"},
-                        Case{"0,0\n1,x\n", "--shape circular --diameter 6 --spacing 1", "t.csv:2:"},
-                        Case{"0,0\n9,0\n", "--shape circular --diameter -6 --spacing 1", "radius must be finite and positive"},
-                        Case{"0,0\n9,0\n", "--shape circular --diameter 6 --spacing 0", "spacing must be finite and positive"},
-                        Case{"0,0\n9,0\n", "--shape rectangular --height 0 --width 2 --spacing 1", "height a must be"},
-                        Case{"0,0\n9,0\n", "--shape rectangular --height 1 --width 2", "exactly one of --spacing"},
-                        Case{"0,0\n9,0\n", "--shape circular --spacing 1", "--diameter is required"},
-                        Case{"0,0\n9,0\n", "--shape circular --diameter 6 --spacing 1 --pose 1,2", "--pose expects"}}) {
+  for (const Case& c :
+       {Case{"0,0\n0,0\n", "--shape circular --diameter 6 --spacing 1", "at least two distinct"},
+        Case{"0,0\n1,x\n", "--shape circular --diameter 6 --spacing 1", "t.csv:2:"},
+        Case{"0,0\n9,0\n", "--shape circular --diameter -6 --spacing 1", "radius must be finite and positive"},
+        Case{"0,0\n9,0\n", "--shape circular --diameter 6 --spacing 0", "spacing must be finite and positive"},
+        Case{"0,0\n9,0\n", "--shape rectangular --height 0 --width 2 --spacing 1", "height a must be"},
+        Case{"0,0\n9,0\n", "--shape rectangular --height 1 --width 2", "exactly one of --spacing"},
+        Case{"0,0\n9,0\n", "--shape circular --spacing 1", "--diameter is required"},
+        Case{"0,0\n9,0\n", "--shape circular --diameter 6 --spacing 1 --pose 1,2", "--pose expects"}}) {
     const fs::path traj = write("t.csv", c.traj);
     const CommandResult r = run("filter --trajectory " + traj.string() + " --points " + pts.string() + " " + c.args +
-                      " --output-indices " + out.string());
+                                " --output-indices " + out.string());
     EXPECT_NE(r.exit_code, 0) << c.args;
     EXPECT_NE(r.err.find(c.expected), std::string::npos) << c.args << " → " << r.err;
     EXPECT_FALSE(fs::exists(out)) << c.args;
@@ -97,12 +99,14 @@ TEST_F(Cli, EvalArtificialCsvMatchesThePaper) {
   std::getline(lines, line);
   EXPECT_EQ(line.rfind("straight,circular,150,10,6234,0,6197,8020,1.000000,0.501488,0.696983,", 0), 0u) << line;
   int rows = 1;
-  while (std::getline(lines, line)) ++rows;
+  while (std::getline(lines, line))
+    ++rows;
   EXPECT_EQ(rows, 7);
 }
 
 TEST_F(Cli, EvalArtificialWritesSvgPictures) {
-  const CommandResult r = run("eval artificial --data curved --shape rectangular --reps 1 --svg " + (dir_ / "svg").string());
+  const CommandResult r =
+      run("eval artificial --data curved --shape rectangular --reps 1 --svg " + (dir_ / "svg").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string svg = slurp(dir_ / "svg" / "curved_rectangular_010.svg");
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
@@ -118,17 +122,18 @@ TEST_F(Cli, LidarDumpReportsTheMrptCapture) {
   const fs::path points = dir_ / "points.csv";
   const CommandResult r = run("lidar-dump --json " + capture.string() + " --points " + points.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (const char* field :
-       {"\"data_packets\": 293,", "\"position_packets\": 57,", "\"unsupported_product\": 0}", "\"model\": \"VLP-16\"",
-        "\"product_id\": \"0x22\"", "\"return_mode\": \"strongest\"", "\"frames\": 3,", "\"partial_frames\": 2,",
-        "\"points\": 73486,", "\"lost_packets\": 0,",
-        "\"first\": {\"utc\": \"2016-01-21T08:18:02.000Z\", \"valid\": true, \"lat\": 36.829130930, \"lon\": -2.407571547}"}) {
+  for (const char* field : {"\"data_packets\": 293,", "\"position_packets\": 57,", "\"unsupported_product\": 0}",
+                            "\"model\": \"VLP-16\"", "\"product_id\": \"0x22\"", "\"return_mode\": \"strongest\"",
+                            "\"frames\": 3,", "\"partial_frames\": 2,", "\"points\": 73486,", "\"lost_packets\": 0,",
+                            "\"first\": {\"utc\": \"2016-01-21T08:18:02.000Z\", \"valid\": true, \"lat\": "
+                            "36.829130930, \"lon\": -2.407571547}"}) {
     EXPECT_NE(r.out.find(field), std::string::npos) << field << " not in " << r.out;
   }
   const std::string csv = slurp(points);
   EXPECT_EQ(csv.rfind("frame,x,y,z,intensity,ring,azimuth_deg,distance_m,time_ns,return_type\n", 0), 0u);
   std::size_t rows = 0;
-  for (const char c : csv) rows += c == '\n' ? 1 : 0;
+  for (const char c : csv)
+    rows += c == '\n' ? 1 : 0;
   EXPECT_EQ(rows, 73486u + 1u);
   EXPECT_FALSE(fs::exists(dir_ / "points.csv.partial"));
 }

@@ -12,8 +12,8 @@
 #include "cli_fixture.hpp"
 #include "gpsd_chk.hpp"
 #include "numeric_csv.hpp"
-#include "trajroi/serial/byte_log.hpp"
 #include "test_data.hpp"
+#include "trajroi/serial/byte_log.hpp"
 
 namespace {
 
@@ -37,7 +37,8 @@ std::multimap<std::string, std::pair<std::string, std::string>> gpsd_positions(c
   for (std::string line; std::getline(in, line);) {
     if (line.rfind("{\"class\":\"TPV\"", 0) != 0) continue;
     std::string lat = trajroi::test::json_raw(line, "lat");
-    if (!lat.empty()) out.emplace(trajroi::test::json_raw(line, "time"), std::make_pair(lat, trajroi::test::json_raw(line, "lon")));
+    if (!lat.empty())
+      out.emplace(trajroi::test::json_raw(line, "time"), std::make_pair(lat, trajroi::test::json_raw(line, "lon")));
   }
   return out;
 }
@@ -85,17 +86,17 @@ TEST_P(GnssDumpCli, JsonFixesEqualGpsdText) {
 // Equal counts are those of the library test (tests/ublox/capture_test.cpp), where each
 // exception is explained; gpsd's zed-f9p-hp and zed-f9r positions come from NAV-HPPOSLLH and
 // NMEA, which NAV-PVT's 1e-7° cannot print identically.
-INSTANTIATE_TEST_SUITE_P(
-    Logs, GnssDumpCli,
-    ::testing::Values(GnssCase{"ublox/gpsd/ublox-neo-m8n.log", 24, 22, R"({"NAV-PVT": 24, "NAV-TIMEGPS": 23, "NAV-SAT": 5})"},
-                      GnssCase{"ublox/gpsd/ublox-glo.log", 299, 291, nullptr},
-                      GnssCase{"ublox/gpsd/ublox-neo-m8l.log", 19, 17, nullptr},
-                      GnssCase{"ublox/gpsd/ublox-neo-m8p.log", 59, 58, nullptr},
-                      GnssCase{"ublox/gpsd/ublox-zed-f9t-rtcm3.log", 26, 22, nullptr},
-                      GnssCase{"ublox/gpsd/ublox8-uniqid-monhw.log", 7, 6, nullptr},
-                      GnssCase{"ublox/gpsd/ublox-zed-f9p-hp.log", 29, 0, nullptr},
-                      GnssCase{"ublox/gpsd/ublox-zed-f9r.log", 30, 0, nullptr}),
-    [](const ::testing::TestParamInfo<GnssCase>& p) { return "log" + std::to_string(p.index); });
+INSTANTIATE_TEST_SUITE_P(Logs, GnssDumpCli,
+                         ::testing::Values(GnssCase{"ublox/gpsd/ublox-neo-m8n.log", 24, 22,
+                                                    R"({"NAV-PVT": 24, "NAV-TIMEGPS": 23, "NAV-SAT": 5})"},
+                                           GnssCase{"ublox/gpsd/ublox-glo.log", 299, 291, nullptr},
+                                           GnssCase{"ublox/gpsd/ublox-neo-m8l.log", 19, 17, nullptr},
+                                           GnssCase{"ublox/gpsd/ublox-neo-m8p.log", 59, 58, nullptr},
+                                           GnssCase{"ublox/gpsd/ublox-zed-f9t-rtcm3.log", 26, 22, nullptr},
+                                           GnssCase{"ublox/gpsd/ublox8-uniqid-monhw.log", 7, 6, nullptr},
+                                           GnssCase{"ublox/gpsd/ublox-zed-f9p-hp.log", 29, 0, nullptr},
+                                           GnssCase{"ublox/gpsd/ublox-zed-f9r.log", 30, 0, nullptr}),
+                         [](const ::testing::TestParamInfo<GnssCase>& p) { return "log" + std::to_string(p.index); });
 
 TEST_F(Cli, GnssDumpOfPyubx2LogsPrintsTheirFixes) {
   TRAJROI_REQUIRE_DATA(nav, "ublox/pyubx2/pygpsdata-NAV.log");
@@ -103,8 +104,10 @@ TEST_F(Cli, GnssDumpOfPyubx2LogsPrintsTheirFixes) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // pyubx2's own test expects this NAV-PVT: 2021-12-04 11:34:59, lat 53.4507228, lon −2.2402855.
   EXPECT_NE(r.out.find("\"utc\": \"2021-12-04T11:34:59.000Z\""), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("\"lat\": 53.450722800, \"lon\": -2.240285500, \"height_m\": 91.184, \"hmsl_m\": 42.701, \"h_acc_m\": 1.491"),
-            std::string::npos);
+  EXPECT_NE(
+      r.out.find(
+          "\"lat\": 53.450722800, \"lon\": -2.240285500, \"height_m\": 91.184, \"hmsl_m\": 42.701, \"h_acc_m\": 1.491"),
+      std::string::npos);
 }
 
 // A run recorded as .trjb (chunks of any size, with times) dumps exactly as the raw log.
@@ -170,10 +173,11 @@ TEST_P(ImuDumpCli, CsvEqualsTheAuthorsCsv) {
   const auto theirs = trajroi::test::read_numeric_csv(trajroi::test::read_file(reference));
   ASSERT_EQ(ours.size(), c.rows);
   // The author's columns, in order, and ours holding the same quantity.
-  const std::vector<std::string> mapping{"mag_x", "mag_y", "mag_z", "accel_x", "accel_y", "accel_z", "gyro_x", "gyro_y",
-                                         "gyro_z", "temp_c", "pres_kpa", "yaw_deg", "pitch_deg", "roll_deg", "dcm_1",
-                                         "dcm_2", "dcm_3", "dcm_4", "dcm_5", "dcm_6", "dcm_7", "dcm_8", "dcm_9",
-                                         "mag_ned_n", "mag_ned_e", "mag_ned_d", "accel_ned_n", "accel_ned_e", "accel_ned_d"};
+  const std::vector<std::string> mapping{
+      "mag_x",     "mag_y",     "mag_z",       "accel_x",     "accel_y",    "accel_z",  "gyro_x", "gyro_y",
+      "gyro_z",    "temp_c",    "pres_kpa",    "yaw_deg",     "pitch_deg",  "roll_deg", "dcm_1",  "dcm_2",
+      "dcm_3",     "dcm_4",     "dcm_5",       "dcm_6",       "dcm_7",      "dcm_8",    "dcm_9",  "mag_ned_n",
+      "mag_ned_e", "mag_ned_d", "accel_ned_n", "accel_ned_e", "accel_ned_d"};
   std::vector<std::size_t> index;
   for (const std::string& name : mapping) {
     const auto it = std::find(ours_header.begin(), ours_header.end(), name);
@@ -195,8 +199,12 @@ TEST_P(ImuDumpCli, CsvEqualsTheAuthorsCsv) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Logs, ImuDumpCli,
-                         ::testing::Values(ImuCase{"vectornav/LoggerWavesInIce_F00294.raw", "vectornav/LoggerWavesInIce_F00294_B.reference.csv", 99, 78, 0},
-                                           ImuCase{"vectornav/LoggerWavesInIce_F00379.raw", "vectornav/LoggerWavesInIce_F00379_B.reference.csv", 8895, -1, 1}),
-                         [](const ::testing::TestParamInfo<ImuCase>& p) { return p.index == 0 ? std::string("F00294") : std::string("F00379"); });
+                         ::testing::Values(ImuCase{"vectornav/LoggerWavesInIce_F00294.raw",
+                                                   "vectornav/LoggerWavesInIce_F00294_B.reference.csv", 99, 78, 0},
+                                           ImuCase{"vectornav/LoggerWavesInIce_F00379.raw",
+                                                   "vectornav/LoggerWavesInIce_F00379_B.reference.csv", 8895, -1, 1}),
+                         [](const ::testing::TestParamInfo<ImuCase>& p) {
+                           return p.index == 0 ? std::string("F00294") : std::string("F00379");
+                         });
 
 }  // namespace

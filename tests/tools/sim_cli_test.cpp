@@ -32,13 +32,17 @@ TEST_F(Cli, SimRefusesABadScenarioAndWritesNothing) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("bad.yaml:9: robot.speed_mps: must be > 0 (got '-2')"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "run"));
-  for (const auto& entry : fs::directory_iterator(dir_)) EXPECT_EQ(entry.path().filename().string().find(".run"), std::string::npos);
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_EQ(entry.path().filename().string().find(".run"), std::string::npos);
 }
 
 TEST_F(Cli, EvalArtificialSpeaksJsonToo) {
   const CommandResult r = run("eval artificial --data straight --shape circular --reps 1 --format json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_EQ(r.out.find("{\"reps\": 1, \"rows\": [\n  {\"data\": \"straight\", \"shape\": \"circular\", \"ratio_pct\": 150,"), 0u) << r.out;
+  EXPECT_EQ(
+      r.out.find("{\"reps\": 1, \"rows\": [\n  {\"data\": \"straight\", \"shape\": \"circular\", \"ratio_pct\": 150,"),
+      0u)
+      << r.out;
   EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 9);  // 7 rows, the opening and the close
   EXPECT_EQ(r.out.find("\"fast_equals_reference\": false"), std::string::npos);
 }
@@ -65,7 +69,8 @@ TEST_F(Cli, SimThenEveryEvaluationAndRender) {
     EXPECT_TRUE(fs::is_regular_file(run_dir / file)) << file;
   }
 
-  const CommandResult kf = run("eval keyframes --reps 3 --format csv --scenario " + run_dir.string() + " --svg " + (dir_ / "svg").string());
+  const CommandResult kf =
+      run("eval keyframes --reps 3 --format csv --scenario " + run_dir.string() + " --svg " + (dir_ / "svg").string());
   ASSERT_EQ(kf.exit_code, 0) << kf.err;
   std::istringstream lines(kf.out);
   std::string header;
@@ -94,13 +99,15 @@ TEST_F(Cli, SimThenEveryEvaluationAndRender) {
   ASSERT_EQ(acc.exit_code, 0) << acc.err;
   EXPECT_EQ(acc.out.find("shape,frames_per_cloud,clouds,avg_points,min_ms,max_ms,avg_ms\ncircular,1,"), 0u) << acc.out;
 
-  const CommandResult render = run("render --scenario " + run_dir.string() + " --keyframe kf_b --out " + (dir_ / "kf_b.svg").string());
+  const CommandResult render =
+      run("render --scenario " + run_dir.string() + " --keyframe kf_b --out " + (dir_ / "kf_b.svg").string());
   ASSERT_EQ(render.exit_code, 0) << render.err;
   const std::string svg = slurp(dir_ / "kf_b.svg");
   for (const char* panel : {"Raw point cloud", "Long cuboid ROI", "Circular ROI (25 %)", "Rectangular ROI (25 %)"}) {
     EXPECT_NE(svg.find(panel), std::string::npos) << panel;
   }
-  EXPECT_NE(run("render --scenario " + run_dir.string() + " --keyframe nope --out x.svg").err.find("no keyframe named 'nope'"),
+  EXPECT_NE(run("render --scenario " + run_dir.string() + " --keyframe nope --out x.svg")
+                .err.find("no keyframe named 'nope'"),
             std::string::npos);
 }
 

@@ -1,13 +1,13 @@
 // The lock-free SPSC ring: order, capacity, drop counting, and a producer and a consumer
 // hammering it from two threads (run under ThreadSanitizer by the README's test command).
+#include "trajroi/transport/spsc_ring.hpp"
+
 #include <gtest/gtest.h>
 
 #include <array>
 #include <atomic>
 #include <cstdint>
 #include <thread>
-
-#include "trajroi/transport/spsc_ring.hpp"
 
 namespace {
 
@@ -63,7 +63,8 @@ TEST(SpscRing, TwoThreadsPassTwoMillionItemsWithoutLossTearingOrReordering) {
       continue;
     }
     if (item->sequence != expected) break;
-    for (const std::uint64_t c : item->copies) torn += c != expected ? 1 : 0;
+    for (const std::uint64_t c : item->copies)
+      torn += c != expected ? 1 : 0;
     ring.release();
     ++expected;
   }
@@ -79,9 +80,10 @@ TEST(SpscRing, AWaitingPushGivesUpWhenStoppedAndCountsTheDrop) {
   ASSERT_TRUE(ring.try_push([](int& v) { v = 2; }));
   std::atomic<bool> stop{false};
   int waits = 0;
-  const bool pushed = ring.push_wait([](int& v) { v = 3; }, stop, [&] {
-    if (++waits == 3) stop = true;  // the consumer never comes: a stop ends the wait
-  });
+  const bool pushed = ring.push_wait([](int& v) { v = 3; }, stop,
+                                     [&] {
+                                       if (++waits == 3) stop = true;  // the consumer never comes: a stop ends the wait
+                                     });
   EXPECT_FALSE(pushed);
   EXPECT_EQ(waits, 3);
   EXPECT_EQ(ring.dropped(), 1u);

@@ -2,8 +2,6 @@
 // the data README and gpsd's expected output (.chk) for the same logs.
 #include <gtest/gtest.h>
 
-#include "stream_feed.hpp"
-
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -14,10 +12,11 @@
 #include <vector>
 
 #include "gpsd_chk.hpp"
+#include "stream_feed.hpp"
 #include "test_data.hpp"
+#include "trajroi/framing/utc.hpp"
 #include "trajroi/ublox/framer.hpp"
 #include "trajroi/ublox/messages.hpp"
-#include "trajroi/framing/utc.hpp"
 
 namespace trajroi::ublox {
 namespace {
@@ -69,29 +68,68 @@ const std::vector<LogExpectation>& logs() {
   static const std::vector<LogExpectation> kLogs{
       // The log ends one byte short of the checksum of a 24th NAV-TIMEGPS.
       {"ublox/gpsd/ublox-neo-m8n.log", 52, {{"NAV-PVT", 24}, {"NAV-TIMEGPS", 23}, {"NAV-SAT", 5}}, 1},
-      {"ublox/gpsd/ublox-zed-f9p-hp.log", 293,
-       {{"NAV-PVT", 29}, {"NAV-POSECEF", 29}, {"NAV-DOP", 29}, {"NAV-VELECEF", 29}, {"NAV-HPPOSECEF", 29},
-        {"NAV-HPPOSLLH", 29}, {"NAV-TIMEGPS", 29}, {"NAV-TIMEUTC", 29}, {"NAV-TIMELS", 29}, {"NAV-EOE", 29},
+      {"ublox/gpsd/ublox-zed-f9p-hp.log",
+       293,
+       {{"NAV-PVT", 29},
+        {"NAV-POSECEF", 29},
+        {"NAV-DOP", 29},
+        {"NAV-VELECEF", 29},
+        {"NAV-HPPOSECEF", 29},
+        {"NAV-HPPOSLLH", 29},
+        {"NAV-TIMEGPS", 29},
+        {"NAV-TIMEUTC", 29},
+        {"NAV-TIMELS", 29},
+        {"NAV-EOE", 29},
         {"NAV-SAT", 3}},
        0},
-      {"ublox/gpsd/ublox-glo.log", 2982,
-       {{"NAV-PVT", 299}, {"NAV-DOP", 300}, {"NAV-SAT", 300}, {"NAV-SIG", 300}, {"NAV-TIMEGPS", 300},
-        {"NAV-EOE", 300}, {"NAV-POSECEF", 299}, {"NAV-VELECEF", 299}, {"NAV-TIMELS", 1}, {"RXM-SFRBX", 584}},
+      {"ublox/gpsd/ublox-glo.log",
+       2982,
+       {{"NAV-PVT", 299},
+        {"NAV-DOP", 300},
+        {"NAV-SAT", 300},
+        {"NAV-SIG", 300},
+        {"NAV-TIMEGPS", 300},
+        {"NAV-EOE", 300},
+        {"NAV-POSECEF", 299},
+        {"NAV-VELECEF", 299},
+        {"NAV-TIMELS", 1},
+        {"RXM-SFRBX", 584}},
        0},
-      {"ublox/gpsd/ublox-neo-m8l.log", 1388,
-       {{"NAV-PVT", 19}, {"ESF-MEAS", 612}, {"HNR-PVT", 189}, {"HNR-ATT", 189}, {"HNR-INS", 189},
-        {"ESF-STATUS", 19}, {"ESF-ALG", 19}, {"ESF-INS", 19}, {"NAV-0x3D", 19}},
+      {"ublox/gpsd/ublox-neo-m8l.log",
+       1388,
+       {{"NAV-PVT", 19},
+        {"ESF-MEAS", 612},
+        {"HNR-PVT", 189},
+        {"HNR-ATT", 189},
+        {"HNR-INS", 189},
+        {"ESF-STATUS", 19},
+        {"ESF-ALG", 19},
+        {"ESF-INS", 19},
+        {"NAV-0x3D", 19}},
        0},
-      {"ublox/gpsd/ublox-zed-f9r.log", 277, {{"NAV-PVT", 30}, {"NAV-CLOCK", 30}, {"NAV-SAT", 30}, {"NAV-SIG", 30}, {"MON-RF", 7}}, 0},
+      {"ublox/gpsd/ublox-zed-f9r.log",
+       277,
+       {{"NAV-PVT", 30}, {"NAV-CLOCK", 30}, {"NAV-SAT", 30}, {"NAV-SIG", 30}, {"MON-RF", 7}},
+       0},
       {"ublox/gpsd/ublox-zed-f9t-rtcm3.log", 136, {{"NAV-PVT", 26}}, 0},
       {"ublox/gpsd/ublox-neo-m8p.log", 484, {{"NAV-PVT", 59}, {"NAV-RELPOSNED", 59}, {"RXM-RTCM", 12}}, 1},
-      {"ublox/gpsd/ublox8-uniqid-monhw.log", 100,
-       {{"NAV-PVT", 7}, {"NAV-SOL", 7}, {"ACK-ACK", 31}, {"ACK-NAK", 2}, {"CFG-PRT", 1}, {"MON-VER", 4},
-        {"MON-RXBUF", 1}, {"MON-TXBUF", 1}, {"SEC-UNIQID", 1}},
+      {"ublox/gpsd/ublox8-uniqid-monhw.log",
+       100,
+       {{"NAV-PVT", 7},
+        {"NAV-SOL", 7},
+        {"ACK-ACK", 31},
+        {"ACK-NAK", 2},
+        {"CFG-PRT", 1},
+        {"MON-VER", 4},
+        {"MON-RXBUF", 1},
+        {"MON-TXBUF", 1},
+        {"SEC-UNIQID", 1}},
        1},  // the log ends 35 bytes into a 68-byte MON-HW
       {"ublox/pyubx2/pygpsdata-NAV.log", 28, {{"NAV-PVT", 1}, {"NAV-TIMENAVIC", 1}, {"NAV-TIMETRUSTED", 1}}, 0},
-      {"ublox/pyubx2/pygpsdata-MIXED.log", 300,
-       {{"NAV-PVT", 39}, {"NAV-SOL", 39}, {"NAV-SVINFO", 39}, {"NAV-STATUS", 32}, {"NAV-SAT", 28}}, 0},
+      {"ublox/pyubx2/pygpsdata-MIXED.log",
+       300,
+       {{"NAV-PVT", 39}, {"NAV-SOL", 39}, {"NAV-SVINFO", 39}, {"NAV-STATUS", 32}, {"NAV-SAT", 28}},
+       0},
       {"ublox/pyubx2/pygpsdata-NAV-ZED-X20P.log", 60, {{"NAV-PVT", 2}}, 0},
   };
   return kLogs;
@@ -108,7 +146,9 @@ std::string file_test_name(const ::testing::TestParamInfo<T>& param) {
   return name;
 }
 
-void PrintTo(const LogExpectation& e, std::ostream* os) { *os << e.file; }
+void PrintTo(const LogExpectation& e, std::ostream* os) {
+  *os << e.file;
+}
 
 class UbxLog : public ::testing::TestWithParam<LogExpectation> {};
 
@@ -122,7 +162,8 @@ TEST_P(UbxLog, FrameCountsMatchTheReadmeWithNoChecksumError) {
   EXPECT_EQ(p.counters.checksum_errors, 0U);
   EXPECT_EQ(p.counters.bad_lengths, 0U);
   EXPECT_EQ(p.counters.truncated, e.truncated);
-  for (const auto& [name, n] : e.by_type) EXPECT_EQ(count_of(p, name), n) << name;
+  for (const auto& [name, n] : e.by_type)
+    EXPECT_EQ(count_of(p, name), n) << name;
   // Every byte is either inside a good frame or counted as skipped.
   EXPECT_EQ(p.counters.frame_bytes + p.counters.skipped_bytes, bytes.size());
 }
@@ -148,12 +189,23 @@ TEST_P(UbxLog, EveryNavPvtDecodes) {
     if (f.msg_class != kClassNav) continue;
     bool ok = true;
     switch (f.msg_id) {
-      case kIdNavPvt: ok = decode_nav_pvt(f.payload).ok(); break;
-      case kIdNavRelposned: ok = decode_nav_relposned(f.payload).ok(); break;
-      case kIdNavHpposllh: ok = decode_nav_hpposllh(f.payload).ok(); break;
-      case kIdNavStatus: ok = decode_nav_status(f.payload).ok(); break;
-      case kIdNavCov: ok = decode_nav_cov(f.payload).ok(); break;
-      default: break;
+      case kIdNavPvt:
+        ok = decode_nav_pvt(f.payload).ok();
+        break;
+      case kIdNavRelposned:
+        ok = decode_nav_relposned(f.payload).ok();
+        break;
+      case kIdNavHpposllh:
+        ok = decode_nav_hpposllh(f.payload).ok();
+        break;
+      case kIdNavStatus:
+        ok = decode_nav_status(f.payload).ok();
+        break;
+      case kIdNavCov:
+        ok = decode_nav_cov(f.payload).ok();
+        break;
+      default:
+        break;
     }
     EXPECT_TRUE(ok) << message_name(f.msg_class, f.msg_id);
   }
@@ -189,11 +241,11 @@ enum class Source { kNavPvt, kNavHpposllh, kNmea };
 
 struct ChkExpectation {
   const char* file;
-  Source source;            // where gpsd took the TPV position from for this log
-  std::size_t epochs;       // NAV-PVT epochs
-  std::size_t agree;        // with a TPV of the same time that agrees
-  std::size_t no_fix;       // fixType 0: gpsd printed a mode-1 TPV without a position
-  std::size_t without_tpv;  // gpsd printed no TPV at that time (it starts reporting late)
+  Source source;                   // where gpsd took the TPV position from for this log
+  std::size_t epochs;              // NAV-PVT epochs
+  std::size_t agree;               // with a TPV of the same time that agrees
+  std::size_t no_fix;              // fixType 0: gpsd printed a mode-1 TPV without a position
+  std::size_t without_tpv;         // gpsd printed no TPV at that time (it starts reporting late)
   std::set<std::string> disagree;  // known, explained below
 };
 
@@ -216,7 +268,9 @@ const std::vector<ChkExpectation>& chk_logs() {
   return kChk;
 }
 
-void PrintTo(const ChkExpectation& e, std::ostream* os) { *os << e.file; }
+void PrintTo(const ChkExpectation& e, std::ostream* os) {
+  *os << e.file;
+}
 
 class GpsdChk : public ::testing::TestWithParam<ChkExpectation> {};
 
@@ -228,7 +282,8 @@ TEST_P(GpsdChk, NavPvtEpochsEqualGpsdTpv) {
   TRAJROI_REQUIRE_DATA(chk_path, chk_file);
   const Parsed p = parse(as_bytes(test::read_file(path)));
   std::multimap<std::string, test::GpsdTpv> tpv_by_time;
-  for (const test::GpsdTpv& t : test::read_gpsd_tpv(test::read_file(chk_path))) tpv_by_time.emplace(t.time, t);
+  for (const test::GpsdTpv& t : test::read_gpsd_tpv(test::read_file(chk_path)))
+    tpv_by_time.emplace(t.time, t);
   ASSERT_FALSE(tpv_by_time.empty());
 
   std::map<std::uint32_t, NavHpposllh> hp_by_itow;
@@ -257,7 +312,8 @@ TEST_P(GpsdChk, NavPvtEpochsEqualGpsdTpv) {
     }
     if (pvt.fix_type() == FixType::kNoFix) {
       bool all_without_position = true;
-      for (auto it = first; it != last; ++it) all_without_position &= it->second.mode == 1 && std::isnan(it->second.lat);
+      for (auto it = first; it != last; ++it)
+        all_without_position &= it->second.mode == 1 && std::isnan(it->second.lat);
       EXPECT_TRUE(all_without_position) << time;
       ++no_fix;
       continue;
@@ -279,7 +335,8 @@ TEST_P(GpsdChk, NavPvtEpochsEqualGpsdTpv) {
       tol.m = 0.1 + 1e-6;
     }
     bool any = false;
-    for (auto it = first; it != last; ++it) any |= agrees(it->second, pos, tol);
+    for (auto it = first; it != last; ++it)
+      any |= agrees(it->second, pos, tol);
     if (any) {
       ++agree;
     } else {
@@ -343,7 +400,7 @@ TEST(NeoM8p, RelposnedIsVersion0WithCarrierSolutions) {
     const auto d = decode_nav_relposned(f.payload);
     ASSERT_TRUE(d.ok());
     EXPECT_EQ(d.value.version, 0);
-    EXPECT_FALSE(d.value.heading_valid);  // version 0 carries no heading
+    EXPECT_FALSE(d.value.heading_valid);              // version 0 carries no heading
     EXPECT_TRUE(pvt_itow.contains(d.value.itow_ms));  // one per navigation epoch
     ++seen;
   }

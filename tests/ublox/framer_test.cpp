@@ -1,16 +1,16 @@
 // The UBX framer and encoders on synthetic streams built here: every resynchronisation path.
-#include <gtest/gtest.h>
+#include "trajroi/ublox/framer.hpp"
 
-#include "stream_feed.hpp"
+#include <gtest/gtest.h>
 
 #include <cstdint>
 #include <random>
 #include <span>
 #include <vector>
 
+#include "stream_feed.hpp"
 #include "trajroi/framing/utc.hpp"
 #include "trajroi/ublox/config.hpp"
-#include "trajroi/ublox/framer.hpp"
 #include "trajroi/ublox/messages.hpp"
 
 namespace trajroi::ublox {
@@ -19,12 +19,14 @@ namespace {
 using Bytes = std::vector<std::uint8_t>;
 
 void append(Bytes& out, const Bytes& more) {
-  for (const std::uint8_t b : more) out.push_back(b);
+  for (const std::uint8_t b : more)
+    out.push_back(b);
 }
 
 Bytes frame_with(std::uint8_t cls, std::uint8_t id, std::size_t payload_bytes, std::uint8_t fill) {
   Bytes payload(payload_bytes);
-  for (std::size_t i = 0; i < payload_bytes; ++i) payload[i] = static_cast<std::uint8_t>(fill + i);
+  for (std::size_t i = 0; i < payload_bytes; ++i)
+    payload[i] = static_cast<std::uint8_t>(fill + i);
   return encode_frame(cls, id, payload);
 }
 
@@ -33,7 +35,8 @@ struct Result {
   framing::FramerCounters counters;
 };
 
-Result run(std::span<const std::uint8_t> bytes, std::size_t chunk = 0, std::size_t max_payload = kDefaultMaxPayloadBytes) {
+Result run(std::span<const std::uint8_t> bytes, std::size_t chunk = 0,
+           std::size_t max_payload = kDefaultMaxPayloadBytes) {
   Framer framer(max_payload);
   Result r;
   const auto sink = [&](const Message& m) { r.payloads.emplace_back(m.payload.begin(), m.payload.end()); };
@@ -72,7 +75,8 @@ TEST(UbxFramer, CorruptLengthDoesNotSwallowFollowingFrames) {
   corrupt[4] = 0xFF;  // claims 0x01FF = 511 bytes
   corrupt[5] = 0x01;
   Bytes stream = corrupt;
-  for (int i = 0; i < 5; ++i) append(stream, frame_with(0x01, 0x07, 92, static_cast<std::uint8_t>(i)));
+  for (int i = 0; i < 5; ++i)
+    append(stream, frame_with(0x01, 0x07, 92, static_cast<std::uint8_t>(i)));
   for (const std::size_t chunk : {std::size_t{0}, std::size_t{1}, std::size_t{13}}) {
     const Result r = run(stream, chunk);
     EXPECT_EQ(r.payloads.size(), 5U) << "chunk " << chunk;
@@ -127,7 +131,8 @@ TEST(UbxFramer, GarbageWithSyncBytesNeverCostsAGoodFrame) {
   const Result r = run(stream, 0, 512);
   EXPECT_GE(r.payloads.size(), 300U);  // garbage may itself hold a valid frame by chance
   std::size_t pvt = 0;
-  for (const Bytes& p : r.payloads) pvt += p.size() == 92 ? 1U : 0U;
+  for (const Bytes& p : r.payloads)
+    pvt += p.size() == 92 ? 1U : 0U;
   EXPECT_EQ(pvt, 300U);
 }
 
@@ -143,7 +148,8 @@ TEST(UbxFramer, StreamCutAtEveryOffset) {
   for (std::size_t cut = 0; cut <= stream.size(); ++cut) {
     const Result r = run(std::span<const std::uint8_t>(stream).first(cut), 3);
     std::size_t complete = 0;
-    for (const std::size_t end : ends) complete += end <= cut ? 1U : 0U;
+    for (const std::size_t end : ends)
+      complete += end <= cut ? 1U : 0U;
     EXPECT_EQ(r.payloads.size(), complete) << "cut " << cut;
     EXPECT_EQ(r.counters.checksum_errors, 0U) << "cut " << cut;
     EXPECT_EQ(r.counters.frame_bytes + r.counters.skipped_bytes, cut) << "cut " << cut;
@@ -151,7 +157,8 @@ TEST(UbxFramer, StreamCutAtEveryOffset) {
 }
 
 TEST(UbxConfig, ValsetEncodesKeysWithTheirSizes) {
-  const std::pair<std::uint32_t, std::uint64_t> items[] = {{kKeyRateMeas, 100}, {msgout_key(PoseMessage::kNavPvt, Port::kUart1), 1}};
+  const std::pair<std::uint32_t, std::uint64_t> items[] = {{kKeyRateMeas, 100},
+                                                           {msgout_key(PoseMessage::kNavPvt, Port::kUart1), 1}};
   const Bytes frame = encode_cfg_valset(items, kLayerRam | kLayerBbr);
   const Bytes expected_payload{0x00, 0x03, 0x00, 0x00,              // version, layers, reserved
                                0x01, 0x00, 0x21, 0x30, 0x64, 0x00,  // CFG-RATE-MEAS = 100 ms (U2)
@@ -217,12 +224,13 @@ TEST(UbxMessages, RelposnedVersion1HeadingAndCarrierSolution) {
   Bytes p(64);
   p[0] = 1;
   const auto put32 = [&](std::size_t at, std::uint32_t v) {
-    for (int i = 0; i < 4; ++i) p[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (8 * i));
+    for (int i = 0; i < 4; ++i)
+      p[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (8 * i));
   };
-  put32(8, 120);                                   // N 1.20 m
-  put32(12, static_cast<std::uint32_t>(-35));      // E −0.35 m
-  put32(24, 27'012'345);                           // heading 270.12345°
-  p[32] = 5;                                       // +0.5 mm north
+  put32(8, 120);                                          // N 1.20 m
+  put32(12, static_cast<std::uint32_t>(-35));             // E −0.35 m
+  put32(24, 27'012'345);                                  // heading 270.12345°
+  p[32] = 5;                                              // +0.5 mm north
   put32(60, 0x01U | 0x04U | (2U << 3) | 0x20U | 0x100U);  // fixOK, valid, fixed, moving, heading valid
   const auto d = decode_nav_relposned(p);
   ASSERT_TRUE(d.ok());
@@ -263,7 +271,8 @@ TEST(UbxMessages, NavPvtUtcNeedsTheFlagsAndARealDate) {
   p[10] = 1;
   p[11] = 0x03;  // validDate, validTime
   const std::int32_t nano = -100231;
-  for (int i = 0; i < 4; ++i) p[16 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(static_cast<std::uint32_t>(nano) >> (8 * i));
+  for (int i = 0; i < 4; ++i)
+    p[16 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(static_cast<std::uint32_t>(nano) >> (8 * i));
   NavPvt m = decode_nav_pvt(p).value;
   ASSERT_TRUE(m.utc_valid());
   EXPECT_EQ(m.utc_ns(), 1'500'454'201'000'000'000LL - 100231);  // date -u -d 2017-07-19T08:50:01Z +%s

@@ -11,7 +11,8 @@ namespace {
 
 template <class T>
 T any(std::mt19937& rng) {
-  return static_cast<T>(std::uniform_int_distribution<std::int64_t>(std::numeric_limits<T>::min(), std::numeric_limits<T>::max())(rng));
+  return static_cast<T>(
+      std::uniform_int_distribution<std::int64_t>(std::numeric_limits<T>::min(), std::numeric_limits<T>::max())(rng));
 }
 
 // Every message goes through the framer too, so the checksum is checked.

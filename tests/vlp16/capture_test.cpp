@@ -8,12 +8,12 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <cstdio>
 #include <map>
-#include <set>
 #include <numbers>
+#include <set>
 
 #include "pcd_reader.hpp"
 #include "test_data.hpp"
@@ -78,8 +78,7 @@ Replay replay(const std::filesystem::path& path, const Calibration& calibration 
 std::int64_t utc_ns(int y, unsigned mo, unsigned d, int h, int mi, int s) {
   namespace c = std::chrono;
   const c::sys_days date{c::year{y} / c::month{mo} / c::day{d}};
-  return (c::duration_cast<c::nanoseconds>(date.time_since_epoch()) + c::hours{h} + c::minutes{mi} +
-          c::seconds{s})
+  return (c::duration_cast<c::nanoseconds>(date.time_since_epoch()) + c::hours{h} + c::minutes{mi} + c::seconds{s})
       .count();
 }
 
@@ -180,8 +179,7 @@ TEST_P(Vlp16RejectsOtherModels, EveryPacketRejectedWithTheReason) {
   TRAJROI_REQUIRE_DATA(path, GetParam().file);
   const Replay r = replay(path);
   EXPECT_EQ(r.data_datagrams, GetParam().data_packets);
-  EXPECT_EQ(r.counters.rejected[static_cast<std::size_t>(PacketError::kUnsupportedProduct)],
-            GetParam().data_packets);
+  EXPECT_EQ(r.counters.rejected[static_cast<std::size_t>(PacketError::kUnsupportedProduct)], GetParam().data_packets);
   EXPECT_EQ(r.counters.decoded_packets, 0u);
   EXPECT_EQ(r.counters.points, 0u);
   EXPECT_TRUE(r.frames.frames.empty());
@@ -190,25 +188,28 @@ TEST_P(Vlp16RejectsOtherModels, EveryPacketRejectedWithTheReason) {
 
 INSTANTIATE_TEST_SUITE_P(
     Captures, Vlp16RejectsOtherModels,
-    testing::Values(
-        RejectedCapture{"velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap", 500,
-                        "product id 0x21 (HDL-32E) is not supported: 553 µs between packets"},
-        RejectedCapture{"velodyne/other_models/rust-lidar-utils_velodyne_vlp32_ACTUALLY_HDL-32E.pcap", 91,
-                        "product id 0x21 (HDL-32E) is not supported"},
-        RejectedCapture{"velodyne/other_models/nebula_vlp32c_strongest_1713492677.DERIVED.pcap", 379,
-                        "product id 0x28 (VLP-32C) is not supported"}));
+    testing::Values(RejectedCapture{"velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap", 500,
+                                    "product id 0x21 (HDL-32E) is not supported: 553 µs between packets"},
+                    RejectedCapture{"velodyne/other_models/rust-lidar-utils_velodyne_vlp32_ACTUALLY_HDL-32E.pcap", 91,
+                                    "product id 0x21 (HDL-32E) is not supported"},
+                    RejectedCapture{"velodyne/other_models/nebula_vlp32c_strongest_1713492677.DERIVED.pcap", 379,
+                                    "product id 0x28 (VLP-32C) is not supported"}));
 
 // nebula's return types (nebula_common.hpp): IDENTICAL 6 when the pair's returns are equal
 // or the other one is empty; otherwise FIRST_* (4, 9) for the farther return, which is the
 // last one, and LAST_* (5, 10) for the nearer, the strongest that is not the last.
 bool same_return(std::uint32_t nebula, ReturnType ours) {
   switch (nebula) {
-    case 6: return true;  // kBoth, or a kLast / kStrongest whose partner was empty
+    case 6:
+      return true;  // kBoth, or a kLast / kStrongest whose partner was empty
     case 4:
-    case 9: return ours == ReturnType::kLast;
+    case 9:
+      return ours == ReturnType::kLast;
     case 5:
-    case 10: return ours == ReturnType::kStrongest;
-    default: return false;
+    case 10:
+      return ours == ReturnType::kStrongest;
+    default:
+      return false;
   }
 }
 
@@ -256,10 +257,13 @@ TEST(Vlp16Capture, NebulaDualReturnReferenceCloudIsReproducedPointForPoint) {
   std::multimap<std::pair<std::uint32_t, long>, Ours> ours;
   for (std::size_t f = 0; f < r.frames.frames.size(); ++f) {
     for (const Point& p : r.frames.frames[f].points) {
-      ours.emplace(std::pair{std::uint32_t{p.ring}, std::lround(double{p.distance_m} / 0.002)}, Ours{&p, f});
+      ours.emplace(std::pair{std::uint32_t{p.ring}, std::lround(static_cast<double>(p.distance_m) / 0.002)},
+                   Ours{&p, f});
     }
   }
-  const auto nebula_azimuth_deg = [&](std::size_t i) { return double{azimuth_rad[i]} * 180.0 / std::numbers::pi; };
+  const auto nebula_azimuth_deg = [&](std::size_t i) {
+    return static_cast<double>(azimuth_rad[i]) * 180.0 / std::numbers::pi;
+  };
   const auto azimuth_step = [](double from_deg, double to_deg) {
     double d = to_deg - from_deg;
     if (d > 180.0) d -= 360.0;
@@ -273,14 +277,14 @@ TEST(Vlp16Capture, NebulaDualReturnReferenceCloudIsReproducedPointForPoint) {
   const auto find = [&](std::size_t i, std::optional<std::size_t> frame) -> const Ours* {
     const Ours* best = nullptr;
     double best_step = 1.0;
-    const auto [begin, end] = ours.equal_range({channel[i], std::lround(double{distance[i]} / 0.002)});
+    const auto [begin, end] = ours.equal_range({channel[i], std::lround(static_cast<double>(distance[i]) / 0.002)});
     for (auto it = begin; it != end; ++it) {
       const Point& p = *it->second.point;
       if ((frame && it->second.frame != *frame) || p.intensity != intensity[i] ||
           !same_return(type[i], p.return_type) || used.count(&p) != 0) {
         continue;
       }
-      const double step = std::abs(azimuth_step(double{p.azimuth_deg}, nebula_azimuth_deg(i)));
+      const double step = std::abs(azimuth_step(static_cast<double>(p.azimuth_deg), nebula_azimuth_deg(i)));
       if (step <= best_step) {
         best_step = step;
         best = &it->second;
@@ -294,9 +298,8 @@ TEST(Vlp16Capture, NebulaDualReturnReferenceCloudIsReproducedPointForPoint) {
     if (const Ours* o = find(i, std::nullopt)) ++votes[o->frame];
   }
   ASSERT_FALSE(votes.empty());
-  const std::size_t frame = std::max_element(votes.begin(), votes.end(), [](auto& a, auto& b) {
-                              return a.second < b.second;
-                            })->first;
+  const std::size_t frame =
+      std::max_element(votes.begin(), votes.end(), [](auto& a, auto& b) { return a.second < b.second; })->first;
 
   // nebula's stamps come from a double of Unix seconds (≈ 240 ns steps): allow 0.5 µs.
   constexpr std::int64_t kTimeTolerance_ns = 500;
@@ -308,7 +311,8 @@ TEST(Vlp16Capture, NebulaDualReturnReferenceCloudIsReproducedPointForPoint) {
     const Ours* match = find(i, frame);
     if (match == nullptr) {
       if (++missing_points <= 10) {
-        ADD_FAILURE() << "nebula point " << i << " (channel " << channel[i] << ", d " << distance[i] << ") has no match";
+        ADD_FAILURE() << "nebula point " << i << " (channel " << channel[i] << ", d " << distance[i]
+                      << ") has no match";
       }
       continue;
     }
@@ -322,17 +326,17 @@ TEST(Vlp16Capture, NebulaDualReturnReferenceCloudIsReproducedPointForPoint) {
     const std::int64_t residual = static_cast<std::int64_t>(time[i]) - std::int64_t{p.time_offset_ns};
     if (previous_residual && std::llabs(residual - *previous_residual) > kTimeTolerance_ns) ++time_jumps;
     previous_residual = residual;
-    const double turn_deg = azimuth_step(double{p.azimuth_deg}, nebula_azimuth_deg(i));
-    double px = p.x, py = p.y;
+    const double turn_deg = azimuth_step(static_cast<double>(p.azimuth_deg), nebula_azimuth_deg(i));
+    double px = static_cast<double>(p.x), py = static_cast<double>(p.y);
     const bool interpolated_alike = std::abs(turn_deg) <= 0.0051;  // nebula's 0.01° rounding
     if (!interpolated_alike) {  // turn our point to nebula's azimuth (clockwise from x)
       const double c = std::cos(turn_deg * std::numbers::pi / 180.0), s = std::sin(turn_deg * std::numbers::pi / 180.0);
-      px = c * double{p.x} + s * double{p.y};
-      py = -s * double{p.x} + c * double{p.y};
+      px = c * static_cast<double>(p.x) + s * static_cast<double>(p.y);
+      py = -s * static_cast<double>(p.x) + c * static_cast<double>(p.y);
       worst_turn_deg = std::max(worst_turn_deg, std::abs(turn_deg));
     }
-    const double error = std::max({std::abs(px - double{x[i]}), std::abs(py - double{y[i]}),
-                                   std::abs(double{p.z} - double{z[i]})});
+    const double error = std::max({std::abs(px - static_cast<double>(x[i])), std::abs(py - static_cast<double>(y[i])),
+                                   std::abs(static_cast<double>(p.z) - static_cast<double>(z[i]))});
     EXPECT_LE(error, 1e-3) << "nebula point " << i << ", azimuth turned by " << turn_deg << "°";
     if (interpolated_alike) {
       ++direct;
@@ -357,10 +361,10 @@ TEST(Vlp16Capture, NebulaDualReturnReferenceCloudIsReproducedPointForPoint) {
   RecordProperty("worst_direct_error_m", std::to_string(worst_direct_m));
   RecordProperty("worst_turned_error_m", std::to_string(worst_turned_m));
   RecordProperty("time_base_changes", std::to_string(time_jumps));
-  std::printf("nebula reference: %zu points direct (worst %.2e m), %zu turned by up to %.3f deg (worst %.2e m), "
-              "%zu time base changes over %u packets\n",
-              direct, worst_direct_m, turned, worst_turn_deg, worst_turned_m, time_jumps,
-              r.frames.frames[frame].packets);
+  std::printf(
+      "nebula reference: %zu points direct (worst %.2e m), %zu turned by up to %.3f deg (worst %.2e m), "
+      "%zu time base changes over %u packets\n",
+      direct, worst_direct_m, turned, worst_turn_deg, worst_turned_m, time_jumps, r.frames.frames[frame].packets);
 }
 
 // A capture cut inside a record: every whole record before the cut is delivered, then an
@@ -385,35 +389,28 @@ TEST(Vlp16Capture, TruncatedCaptureDeliversEveryWholeRecordThenAnError) {
   Datagram datagram;
   std::size_t delivered = 0;
   PacketSource::Next next;
-  while ((next = source.next(datagram)) == PacketSource::Next::kDatagram) ++delivered;
+  while ((next = source.next(datagram)) == PacketSource::Next::kDatagram)
+    ++delivered;
   EXPECT_EQ(delivered, 100u);
   EXPECT_EQ(next, PacketSource::Next::kError);
   EXPECT_NE(source.error().find("truncated"), std::string::npos) << source.error();
   std::filesystem::remove(cut);
 }
 
-// Pacing: × N replays the capture's own timing divided by N (never faster); a port filter
-// leaves the other datagrams out.
-TEST(Vlp16Capture, PacedReplayFollowsTheCaptureClockAndPortsFilter) {
+// A port filter leaves the other datagrams out (pacing is inputs::Pacer's, tested there).
+TEST(Vlp16Capture, APortFilterLeavesTheOtherDatagramsOut) {
   TRAJROI_REQUIRE_DATA(path, "velodyne/vlp16/rust-lidar-utils_velodyne_vlp16_2014_productid0x21.pcap");
   PcapOptions options;
-  options.speed = 5.0;
   options.ports = {kDataPort};
   PcapSource source(path, options);
   Datagram datagram;
   std::size_t delivered = 0;
-  std::int64_t first_ns = 0, last_ns = 0;
-  const auto start = std::chrono::steady_clock::now();
   while (source.next(datagram) == PacketSource::Next::kDatagram) {
     EXPECT_EQ(datagram.destination_port, kDataPort);
-    if (delivered++ == 0) first_ns = datagram.receive_time_ns;
-    last_ns = datagram.receive_time_ns;
+    ++delivered;
   }
-  const auto elapsed_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
   EXPECT_EQ(delivered, 84u);
   EXPECT_EQ(source.skipped_records(), 16u);  // the position packets
-  EXPECT_GE(elapsed_ns, (last_ns - first_ns) / 5);  // 0.110 s of capture at × 5
-  EXPECT_THROW(PcapSource(path, PcapOptions{{kDataPort}, -1.0}), std::invalid_argument);
 }
 
 // Every link type the pcap source reads, in captures written here (nanosecond pcap): one
@@ -422,7 +419,8 @@ TEST(Vlp16Capture, PacedReplayFollowsTheCaptureClockAndPortsFilter) {
 // (Appends byte by byte: GCC 12 warns falsely on vector::insert of small arrays at -O3.)
 std::vector<std::uint8_t> concat(std::vector<std::uint8_t> head, const std::vector<std::uint8_t>& tail) {
   head.reserve(head.size() + tail.size());
-  for (const std::uint8_t b : tail) head.push_back(b);
+  for (const std::uint8_t b : tail)
+    head.push_back(b);
   return head;
 }
 
@@ -430,11 +428,34 @@ std::vector<std::uint8_t> ipv4_udp(std::uint16_t port, const std::vector<std::ui
   const std::size_t total = 20 + 8 + payload.size();
   const auto hi = [](std::size_t v) { return static_cast<std::uint8_t>(v >> 8); };
   const auto lo = [](std::size_t v) { return static_cast<std::uint8_t>(v); };
-  const std::array<std::uint8_t, 28> header = {
-      0x45, 0, hi(total), lo(total), 0, 0, 0, 0, 64, 17 /* UDP */, 0, 0,  // IPv4, no checksum
-      192, 168, 1, 201, 255, 255, 255, 255,                               // addresses
-      hi(port), lo(port), hi(port), lo(port),                             // source, destination port
-      hi(8 + payload.size()), lo(8 + payload.size()), 0, 0};             // UDP length, no checksum
+  const std::array<std::uint8_t, 28> header = {0x45,
+                                               0,
+                                               hi(total),
+                                               lo(total),
+                                               0,
+                                               0,
+                                               0,
+                                               0,
+                                               64,
+                                               17 /* UDP */,
+                                               0,
+                                               0,  // IPv4, no checksum
+                                               192,
+                                               168,
+                                               1,
+                                               201,
+                                               255,
+                                               255,
+                                               255,
+                                               255,  // addresses
+                                               hi(port),
+                                               lo(port),
+                                               hi(port),
+                                               lo(port),  // source, destination port
+                                               hi(8 + payload.size()),
+                                               lo(8 + payload.size()),
+                                               0,
+                                               0};  // UDP length, no checksum
   return concat({header.begin(), header.end()}, payload);
 }
 
@@ -463,7 +484,8 @@ void write_pcap(const std::filesystem::path& path, std::uint32_t link_type,
 
 TEST(Vlp16Capture, EveryLinkTypeYieldsTheSameDatagram) {
   std::vector<std::uint8_t> payload(kDataPacketBytes);
-  for (std::size_t i = 0; i < payload.size(); ++i) payload[i] = static_cast<std::uint8_t>(i * 7);
+  for (std::size_t i = 0; i < payload.size(); ++i)
+    payload[i] = static_cast<std::uint8_t>(i * 7);
   const auto data = ipv4_udp(kDataPort, payload);
   const auto other = ipv4_udp(5353, std::vector<std::uint8_t>(40, 1));
   const auto ethernet = [](std::vector<std::uint16_t> tags, const std::vector<std::uint8_t>& ip) {

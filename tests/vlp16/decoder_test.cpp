@@ -2,14 +2,14 @@
 // manual's formulas, written out here independently of the decoder.
 #include "trajroi/vlp16/decoder.hpp"
 
-#include "packet_builder.hpp"
-#include "test_data.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 #include <vector>
+
+#include "packet_builder.hpp"
+#include "test_data.hpp"
 
 namespace trajroi::vlp16 {
 namespace {
@@ -123,11 +123,11 @@ TEST(Vlp16Decoder, LastReturnModeAndRangeLimits) {
 
 TEST(Vlp16Decoder, DualReturnPairsShareTheFiringAndIdenticalReturnsGiveOnePoint) {
   auto p = make_packet(2000, 40, ReturnMode::kDual);  // pairs (0,1), (2,3), …: 0.40° per pair
-  set_return(p, 0, 3, 1500, 10);  // last
-  set_return(p, 1, 3, 1500, 10);  // strongest, identical → one point
-  set_return(p, 2, 4, 2000, 20);  // last
-  set_return(p, 3, 4, 1800, 90);  // strongest, different → two points
-  set_return(p, 5, 6, 700, 50);   // only the strongest block has a return
+  set_return(p, 0, 3, 1500, 10);                      // last
+  set_return(p, 1, 3, 1500, 10);                      // strongest, identical → one point
+  set_return(p, 2, 4, 2000, 20);                      // last
+  set_return(p, 3, 4, 1800, 90);                      // strongest, different → two points
+  set_return(p, 5, 6, 700, 50);                       // only the strongest block has a return
   const PacketDecoder decoder(Calibration::vlp16_default());
   std::vector<Point> points;
   decoder.decode(p, points);
@@ -161,17 +161,18 @@ std::string sixteen_lasers(const std::string& replace_laser_7 = "") {
   for (int i = 0; i < 16; ++i) {
     yaml += i == 7 && !replace_laser_7.empty()
                 ? replace_laser_7
-                : "  - {laser_id: " + std::to_string(i) + ", vert_correction: " + std::to_string((i % 2 ? 1 : -1) * 0.01 * i) +
-                      ", rot_correction: 0.0}\n";
+                : "  - {laser_id: " + std::to_string(i) +
+                      ", vert_correction: " + std::to_string((i % 2 ? 1 : -1) * 0.01 * i) + ", rot_correction: 0.0}\n";
   }
   return yaml;
 }
 
 TEST(Vlp16Calibration, YamlFieldsAreReadByLaserId) {
-  const Calibration c = parse_calibration_yaml(sixteen_lasers("  - {laser_id: 7, vert_correction: 0.12, rot_correction: "
-                                                              "-0.001, vert_offset_correction: 0.005, "
-                                                              "horiz_offset_correction: 0.002, dist_correction: 0.03}\n"),
-                                               "cal.yaml");
+  const Calibration c =
+      parse_calibration_yaml(sixteen_lasers("  - {laser_id: 7, vert_correction: 0.12, rot_correction: "
+                                            "-0.001, vert_offset_correction: 0.005, "
+                                            "horiz_offset_correction: 0.002, dist_correction: 0.03}\n"),
+                             "cal.yaml");
   EXPECT_DOUBLE_EQ(c.lasers[7].vert_angle_rad, 0.12);
   EXPECT_DOUBLE_EQ(c.lasers[7].rot_correction_rad, -0.001);
   EXPECT_DOUBLE_EQ(c.lasers[7].vert_offset_m, 0.005);
@@ -190,7 +191,8 @@ TEST(Vlp16Calibration, NebulaFileMatchesTheManualAngles) {
   }
   // Rings by elevation: −15° … −1° are the even lasers, +1° … +15° the odd ones.
   const auto rings = c.rings();
-  for (std::size_t i = 0; i < kLasers; ++i) EXPECT_EQ(rings[i], i % 2 == 0 ? i / 2 : 8 + i / 2) << i;
+  for (std::size_t i = 0; i < kLasers; ++i)
+    EXPECT_EQ(rings[i], i % 2 == 0 ? i / 2 : 8 + i / 2) << i;
 }
 
 TEST(Vlp16Calibration, BadFilesNameTheProblem) {
@@ -248,7 +250,8 @@ TEST(Vlp16Decoder, RandomPacketsAreDecodedWithinBoundsAndFullyAccounted) {
   std::vector<Point> points;
   for (int n = 0; n < 2000; ++n) {
     std::vector<std::uint8_t> p(kDataPacketBytes);
-    for (auto& b : p) b = random_byte();
+    for (auto& b : p)
+      b = random_byte();
     for (std::size_t block = 0; block < kBlocks; ++block) {
       p[block * 100] = 0xFF;
       p[block * 100 + 1] = 0xEE;

@@ -2,15 +2,15 @@
 // byte-by-byte packet builder (the layout, independently of both).
 #include "trajroi/vlp16/encoder.hpp"
 
-#include "packet_builder.hpp"
-#include "trajroi/vlp16/decoder.hpp"
-
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cmath>
 #include <random>
 #include <vector>
+
+#include "packet_builder.hpp"
+#include "trajroi/vlp16/decoder.hpp"
 
 namespace trajroi::vlp16 {
 namespace {
@@ -30,7 +30,8 @@ std::vector<FiringBlock> random_blocks(std::mt19937& rng, ReturnMode mode) {
     block.azimuth_cdeg = static_cast<std::uint16_t>(az % 36000);
     az += step(rng);
     for (std::size_t ch = 0; ch < kChannelsPerBlock; ++ch) {
-      block.strongest[ch] = {static_cast<std::uint16_t>(missing(rng) ? 0 : distance(rng)), static_cast<std::uint8_t>(byte(rng))};
+      block.strongest[ch] = {static_cast<std::uint16_t>(missing(rng) ? 0 : distance(rng)),
+                             static_cast<std::uint8_t>(byte(rng))};
       block.last[ch] = same(rng) ? block.strongest[ch]
                                  : Echo{static_cast<std::uint16_t>(missing(rng) ? 0 : distance(rng)),
                                         static_cast<std::uint8_t>(byte(rng))};
@@ -111,7 +112,8 @@ TEST_P(EncoderRoundTrip, BytesMatchTheTestBuilderLayout) {
   const ReturnMode mode = GetParam();
   std::mt19937 rng(42);
   auto blocks = random_blocks(rng, mode);
-  for (std::size_t i = 0; i < blocks.size(); ++i) blocks[i].azimuth_cdeg = static_cast<std::uint16_t>((35990 + 40 * i) % 36000);
+  for (std::size_t i = 0; i < blocks.size(); ++i)
+    blocks[i].azimuth_cdeg = static_cast<std::uint16_t>((35990 + 40 * i) % 36000);
   Packet packet{};
   encode_data_packet({mode, kProductVlp16, 987654}, blocks, packet);
   auto built = make_packet(35990, 40, mode, 0x22, 987654);
@@ -160,7 +162,8 @@ TEST(Vlp16Encoder, RmcSentenceMatchesTheNmeaLayout) {
   EXPECT_EQ(s.substr(0, s.size() - 5), "$GPRMC,093015.25,A,4042.85590,N,11147.83530,W,000.5,271.2,140524,,,A");
   // The checksum, computed here by hand from the XOR of the characters between $ and *.
   unsigned x = 0;
-  for (std::size_t i = 1; i + 5 < s.size(); ++i) x ^= static_cast<unsigned char>(s[i]);
+  for (std::size_t i = 1; i + 5 < s.size(); ++i)
+    x ^= static_cast<unsigned char>(s[i]);
   char tail[8];
   std::snprintf(tail, sizeof tail, "*%02X\r\n", x);
   EXPECT_EQ(s.substr(s.size() - 5), tail);

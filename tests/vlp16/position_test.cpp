@@ -36,7 +36,8 @@ TEST(Vlp16Position, OlderRmcWithoutFractionalSeconds) {
 // Sentences with a correct checksum computed here, so that only the named fault remains.
 std::string with_checksum(const std::string& body) {
   unsigned sum = 0;
-  for (const char c : body) sum ^= static_cast<unsigned char>(c);
+  for (const char c : body)
+    sum ^= static_cast<unsigned char>(c);
   char text[4];
   std::snprintf(text, sizeof text, "%02X", sum);
   return "$" + body + "*" + text;

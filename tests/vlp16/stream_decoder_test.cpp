@@ -29,7 +29,8 @@ struct Sensor {
     auto p = make_packet(static_cast<std::uint16_t>(azimuth_cdeg), step_cdeg, mode, product,
                          static_cast<std::uint32_t>(std::llround(toh_us)) % 3'600'000'000u);
     for (std::size_t block = 0; block < kBlocks; ++block) {
-      for (std::size_t channel = 0; channel < 32; ++channel) set_return(p, block, channel, 1000, 10);
+      for (std::size_t channel = 0; channel < 32; ++channel)
+        set_return(p, block, channel, 1000, 10);
     }
     const std::size_t firings = dual ? kBlocks / 2 : kBlocks;
     azimuth_cdeg = (azimuth_cdeg + step_cdeg * static_cast<std::uint32_t>(firings)) % 36000;
@@ -52,7 +53,7 @@ struct Outcome {
   std::string rejection;
 };
 Outcome run(Sensor sensor, std::size_t count, StreamOptions options = {},
-        const std::function<bool(std::size_t, std::vector<std::uint8_t>&)>& edit = {}) {
+            const std::function<bool(std::size_t, std::vector<std::uint8_t>&)>& edit = {}) {
   Outcome r;
   StreamDecoder decoder(Calibration::vlp16_default(), options);
   for (std::size_t i = 0; i < count; ++i) {
@@ -80,14 +81,17 @@ TEST(Vlp16Stream, CleanStreamGivesWholeSweepsCutAtTheConfiguredAzimuth) {
     EXPECT_TRUE(r.sink.frames.front().partial);
     EXPECT_TRUE(r.sink.frames.back().partial);
     std::size_t points = 0;
-    for (const Frame& f : r.sink.frames) points += f.points.size();
+    for (const Frame& f : r.sink.frames)
+      points += f.points.size();
     EXPECT_EQ(points, r.counters.points);
     for (std::size_t i = 1; i + 1 < r.sink.frames.size(); ++i) {
       const Frame& f = r.sink.frames[i];
       EXPECT_FALSE(f.partial);
       EXPECT_EQ(f.points.size(), kPacketsPerTurn * 384);  // exactly one turn of firings
       // Starts at the first firing at or past the cut, ends at the last before it.
-      const auto phase = [&](const Point& p) { return std::fmod(double{p.azimuth_deg} - cut_deg + 360.0, 360.0); };
+      const auto phase = [&](const Point& p) {
+        return std::fmod(static_cast<double>(p.azimuth_deg) - cut_deg + 360.0, 360.0);
+      };
       EXPECT_LT(phase(f.points.front()), 0.4) << cut_deg;
       EXPECT_GT(phase(f.points.back()), 359.5) << cut_deg;
       // One turn is 75 packets of 1327.104 µs; from a frame's first point to its last is that
@@ -110,7 +114,8 @@ TEST(Vlp16Stream, MissingPacketsAreCountedInTheirFrame) {
   const Outcome r = run(Sensor{}, 3 * kPacketsPerTurn, {}, [](std::size_t i, auto&) { return i < 100 || i > 102; });
   EXPECT_EQ(r.counters.lost_packets, 3u);
   std::uint32_t in_frames = 0;
-  for (const Frame& f : r.sink.frames) in_frames += f.lost_packets;
+  for (const Frame& f : r.sink.frames)
+    in_frames += f.lost_packets;
   EXPECT_EQ(in_frames, 3u);
   EXPECT_EQ(r.sink.frames[1].lost_packets, 3u);  // packets 75 … 149
 }
@@ -279,7 +284,8 @@ TEST(Vlp16Stream, DamagedPacketsAreCountedByReasonAndTheRestDecoded) {
     return true;
   });
   using E = PacketError;
-  for (const E e : {E::kWrongSize, E::kBadBlockFlag, E::kUnknownReturnMode, E::kUnsupportedProduct, E::kAzimuthOutOfRange}) {
+  for (const E e :
+       {E::kWrongSize, E::kBadBlockFlag, E::kUnknownReturnMode, E::kUnsupportedProduct, E::kAzimuthOutOfRange}) {
     EXPECT_EQ(r.counters.rejected[static_cast<std::size_t>(e)], 1u) << to_string(e);
   }
   EXPECT_EQ(r.counters.decoded_packets, 35u);

@@ -2,16 +2,15 @@
 // frame counts from the data README and every decoded value against the author's CSV.
 #include <gtest/gtest.h>
 
-#include "stream_feed.hpp"
-
 #include <cmath>
 #include <cstdint>
-#include <sstream>
 #include <span>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "numeric_csv.hpp"
+#include "stream_feed.hpp"
 #include "test_data.hpp"
 #include "trajroi/vn100/decoder.hpp"
 #include "trajroi/vn100/framer.hpp"
@@ -46,7 +45,8 @@ Parsed parse(std::span<const std::uint8_t> bytes, std::size_t chunk = 0) {
 std::vector<double> csv_order(const Sample& s) {
   std::vector<double> v;
   const auto add = [&](const auto& values) {
-    for (const float x : values) v.push_back(static_cast<double>(x));
+    for (const float x : values)
+      v.push_back(static_cast<double>(x));
   };
   add(s.uncomp_mag_gauss);
   add(s.uncomp_accel_mps2);
@@ -74,18 +74,32 @@ struct VnLog {
   const char* frames_only;
   const char* csv;
   std::uint64_t frames;
-  std::uint64_t non_vn_bytes;     // README: bytes outside the CRC-valid frames of the raw file
-  std::uint64_t crc_failures;     // README: candidates in the raw file that fail their CRC
-  std::int64_t frame_without_row; // the frame the author's parser skipped (−1: none)
-  std::size_t junk_rows;          // leading CSV rows that are not frames
+  std::uint64_t non_vn_bytes;      // README: bytes outside the CRC-valid frames of the raw file
+  std::uint64_t crc_failures;      // README: candidates in the raw file that fail their CRC
+  std::int64_t frame_without_row;  // the frame the author's parser skipped (−1: none)
+  std::size_t junk_rows;           // leading CSV rows that are not frames
 };
 
-void PrintTo(const VnLog& log, std::ostream* os) { *os << log.raw; }
+void PrintTo(const VnLog& log, std::ostream* os) {
+  *os << log.raw;
+}
 
-const VnLog kF00294{"vectornav/LoggerWavesInIce_F00294.raw", "vectornav/LoggerWavesInIce_F00294.frames_only.DERIVED.bin",
-                    "vectornav/LoggerWavesInIce_F00294_B.reference.csv", 99, 2767, 0, 78, 0};
-const VnLog kF00379{"vectornav/LoggerWavesInIce_F00379.raw", "vectornav/LoggerWavesInIce_F00379.frames_only.DERIVED.bin",
-                    "vectornav/LoggerWavesInIce_F00379_B.reference.csv", 8895, 334515, 2, -1, 1};
+const VnLog kF00294{"vectornav/LoggerWavesInIce_F00294.raw",
+                    "vectornav/LoggerWavesInIce_F00294.frames_only.DERIVED.bin",
+                    "vectornav/LoggerWavesInIce_F00294_B.reference.csv",
+                    99,
+                    2767,
+                    0,
+                    78,
+                    0};
+const VnLog kF00379{"vectornav/LoggerWavesInIce_F00379.raw",
+                    "vectornav/LoggerWavesInIce_F00379.frames_only.DERIVED.bin",
+                    "vectornav/LoggerWavesInIce_F00379_B.reference.csv",
+                    8895,
+                    334515,
+                    2,
+                    -1,
+                    1};
 
 class VnCapture : public ::testing::TestWithParam<VnLog> {};
 
@@ -100,7 +114,8 @@ TEST_P(VnCapture, RawStreamGivesEveryCrcValidFrameAndCountsTheRest) {
   // The frames found in the dirty stream are, byte for byte, the README's clean stream.
   const std::string clean = test::read_file(clean_path);
   std::string concatenated;
-  for (const auto& f : raw.frames) concatenated.append(reinterpret_cast<const char*>(f.data()), f.size());
+  for (const auto& f : raw.frames)
+    concatenated.append(reinterpret_cast<const char*>(f.data()), f.size());
   EXPECT_TRUE(concatenated == clean);
   // Every frame has the logger's configuration: groups IMU + Attitude, 124 bytes.
   for (const auto& f : raw.frames) {
@@ -166,7 +181,9 @@ TEST(VnCaptureF00294, FirstFrameEqualsTheReadmeValues) {
   // The DCM is a rotation: rows of unit length.
   for (int r = 0; r < 3; ++r) {
     double n = 0;
-    for (int c = 0; c < 3; ++c) n += static_cast<double>(s.dcm[static_cast<std::size_t>(3 * r + c)]) * static_cast<double>(s.dcm[static_cast<std::size_t>(3 * r + c)]);
+    for (int c = 0; c < 3; ++c)
+      n += static_cast<double>(s.dcm[static_cast<std::size_t>(3 * r + c)]) *
+           static_cast<double>(s.dcm[static_cast<std::size_t>(3 * r + c)]);
     EXPECT_NEAR(n, 1.0, 1e-5);
   }
 }

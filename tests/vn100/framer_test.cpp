@@ -1,7 +1,7 @@
 // The VN-100 framer, decoder and commands on frames built here.
-#include <gtest/gtest.h>
+#include "trajroi/vn100/framer.hpp"
 
-#include "stream_feed.hpp"
+#include <gtest/gtest.h>
 
 #include <bit>
 #include <cstdint>
@@ -9,10 +9,10 @@
 #include <span>
 #include <vector>
 
+#include "stream_feed.hpp"
 #include "trajroi/framing/little_endian.hpp"
 #include "trajroi/vn100/command.hpp"
 #include "trajroi/vn100/decoder.hpp"
-#include "trajroi/vn100/framer.hpp"
 
 namespace trajroi::vn100 {
 namespace {
@@ -20,20 +20,28 @@ namespace {
 using Bytes = std::vector<std::uint8_t>;
 
 void append(Bytes& out, const Bytes& more) {
-  for (const std::uint8_t b : more) out.push_back(b);
+  for (const std::uint8_t b : more)
+    out.push_back(b);
 }
-void put_f32(Bytes& out, float v) { framing::put_le_u32(out, std::bit_cast<std::uint32_t>(v)); }
+void put_f32(Bytes& out, float v) {
+  framing::put_le_u32(out, std::bit_cast<std::uint32_t>(v));
+}
 
 // Common group: TimeStartup, TimeGps, YawPitchRoll, Quaternion, AngularRate, Accel, MagPres.
 Bytes common_frame(std::uint64_t startup_ns, float yaw_deg) {
   Bytes payload;
   framing::put_le_u64(payload, startup_ns);
   framing::put_le_u64(payload, 1'300'000'000'123'456'789ULL);
-  for (const float v : {yaw_deg, -2.5F, 1.25F}) put_f32(payload, v);
-  for (const float v : {0.0F, 0.0F, 0.38268343F, 0.92387953F}) put_f32(payload, v);
-  for (const float v : {0.01F, -0.02F, 0.03F}) put_f32(payload, v);
-  for (const float v : {0.1F, 0.2F, -9.81F}) put_f32(payload, v);
-  for (const float v : {0.2F, 0.0F, 0.4F, 21.5F, 101.3F}) put_f32(payload, v);
+  for (const float v : {yaw_deg, -2.5F, 1.25F})
+    put_f32(payload, v);
+  for (const float v : {0.0F, 0.0F, 0.38268343F, 0.92387953F})
+    put_f32(payload, v);
+  for (const float v : {0.01F, -0.02F, 0.03F})
+    put_f32(payload, v);
+  for (const float v : {0.1F, 0.2F, -9.81F})
+    put_f32(payload, v);
+  for (const float v : {0.2F, 0.0F, 0.4F, 21.5F, 101.3F})
+    put_f32(payload, v);
   std::array<std::uint16_t, 8> fields{};
   fields[0] = 0x0001 | 0x0002 | 0x0008 | 0x0010 | 0x0020 | 0x0100 | 0x0400;
   return encode_frame(fields, payload);
@@ -85,9 +93,11 @@ TEST(Vn100Decoder, CommonGroupFieldsAndTimes) {
 
 TEST(Vn100Decoder, TimeGroupAndAttitudeGroupTogether) {
   Bytes payload;
-  framing::put_le_u64(payload, 77);                   // Time: TimeStartup
-  for (const float v : {10.0F, 20.0F, 30.0F}) put_f32(payload, v);  // Attitude: YawPitchRoll
-  for (const float v : {1.0F, 2.0F, 3.0F}) put_f32(payload, v);     // Attitude: LinearAccelBody
+  framing::put_le_u64(payload, 77);  // Time: TimeStartup
+  for (const float v : {10.0F, 20.0F, 30.0F})
+    put_f32(payload, v);  // Attitude: YawPitchRoll
+  for (const float v : {1.0F, 2.0F, 3.0F})
+    put_f32(payload, v);  // Attitude: LinearAccelBody
   std::array<std::uint16_t, 8> fields{};
   fields[1] = 0x0001;
   fields[4] = 0x0002 | 0x0040;
@@ -120,7 +130,8 @@ TEST(Vn100Framer, CorruptGroupSelectionDoesNotSwallowFollowingFrames) {
   corrupt[2] = 0xFF;  // Common mask low byte: every field, about 200 bytes claimed
   corrupt[3] = 0x7F;
   Bytes stream = corrupt;
-  for (std::uint64_t i = 0; i < 4; ++i) append(stream, common_frame(10 + i, 0.0F));
+  for (std::uint64_t i = 0; i < 4; ++i)
+    append(stream, common_frame(10 + i, 0.0F));
   for (const std::size_t chunk : {std::size_t{0}, std::size_t{1}, std::size_t{17}}) {
     const Result r = run(stream, chunk);
     ASSERT_EQ(r.samples.size(), 4U) << "chunk " << chunk;
@@ -147,12 +158,14 @@ TEST(Vn100Framer, GarbageAndMarkersBetweenFrames) {
     const std::string marker = "M," + std::to_string(i * 100) + "\r\nB,\n\r\n";
     stream.insert(stream.end(), marker.begin(), marker.end());
     const int n = byte(rng) % 20;
-    for (int k = 0; k < n; ++k) stream.push_back(static_cast<std::uint8_t>(byte(rng)));
+    for (int k = 0; k < n; ++k)
+      stream.push_back(static_cast<std::uint8_t>(byte(rng)));
     append(stream, common_frame(i, 0.0F));
   }
   const Result r = run(stream);
   std::size_t ours = 0;
-  for (const Sample& s : r.samples) ours += s.has(Field::kTimeStartup) ? 1U : 0U;
+  for (const Sample& s : r.samples)
+    ours += s.has(Field::kTimeStartup) ? 1U : 0U;
   EXPECT_EQ(ours, 300U);
   EXPECT_EQ(run(stream, 1).samples.size(), r.samples.size());
 }
@@ -167,7 +180,8 @@ TEST(Vn100Framer, StreamCutAtEveryOffset) {
   for (std::size_t cut = 0; cut <= stream.size(); ++cut) {
     const Result r = run(std::span<const std::uint8_t>(stream).first(cut), 5);
     std::size_t complete = 0;
-    for (const std::size_t end : ends) complete += end <= cut ? 1U : 0U;
+    for (const std::size_t end : ends)
+      complete += end <= cut ? 1U : 0U;
     EXPECT_EQ(r.samples.size(), complete) << "cut " << cut;
     EXPECT_EQ(r.counters.frame_bytes + r.counters.skipped_bytes, cut) << "cut " << cut;
   }

@@ -22,19 +22,21 @@ float random_float(std::mt19937& rng) {
 
 template <std::size_t N>
 void fill(std::array<float, N>& a, std::mt19937& rng) {
-  for (float& f : a) f = random_float(rng);
+  for (float& f : a)
+    f = random_float(rng);
 }
 
 template <std::size_t N>
 void expect_same(const std::array<float, N>& a, const std::array<float, N>& b, const char* what) {
-  for (std::size_t i = 0; i < N; ++i) EXPECT_EQ(std::bit_cast<std::uint32_t>(a[i]), std::bit_cast<std::uint32_t>(b[i])) << what << "[" << i << "]";
+  for (std::size_t i = 0; i < N; ++i)
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(a[i]), std::bit_cast<std::uint32_t>(b[i])) << what << "[" << i << "]";
 }
 
 TEST(Vn100RoundTrip, RandomSamplesEveryField) {
   std::array<std::uint16_t, 8> fields{};
   fields[0] = 0x0001 | 0x0002 | 0x0004 | 0x0008 | 0x0010 | 0x0020 | 0x0100 | 0x0400 | 0x2000;  // Common
-  fields[2] = 0x0001 | 0x0002 | 0x0004 | 0x0008 | 0x0040 | 0x0080;                           // IMU
-  fields[4] = 0x0001 | 0x0008 | 0x0010 | 0x0020 | 0x0040 | 0x0080 | 0x0100;                  // Attitude
+  fields[2] = 0x0001 | 0x0002 | 0x0004 | 0x0008 | 0x0040 | 0x0080;                             // IMU
+  fields[4] = 0x0001 | 0x0008 | 0x0010 | 0x0020 | 0x0040 | 0x0080 | 0x0100;                    // Attitude
   std::mt19937 rng(5);
   for (int i = 0; i < 200; ++i) {
     Sample s;
@@ -85,7 +87,8 @@ TEST(Vn100RoundTrip, RandomSamplesEveryField) {
     expect_same(d.angular_rate_rps, s.angular_rate_rps, "angular rate");
     expect_same(d.accel_mps2, s.accel_mps2, "accel");
     expect_same(d.mag_gauss, s.mag_gauss, "mag");
-    expect_same(std::array<float, 2>{d.temperature_c, d.pressure_kpa}, std::array<float, 2>{s.temperature_c, s.pressure_kpa}, "temp/pres");
+    expect_same(std::array<float, 2>{d.temperature_c, d.pressure_kpa},
+                std::array<float, 2>{s.temperature_c, s.pressure_kpa}, "temp/pres");
     expect_same(d.uncomp_mag_gauss, s.uncomp_mag_gauss, "uncomp mag");
     expect_same(d.uncomp_accel_mps2, s.uncomp_accel_mps2, "uncomp accel");
     expect_same(d.uncomp_gyro_rps, s.uncomp_gyro_rps, "uncomp gyro");

@@ -37,18 +37,18 @@ void write_row_svg(const std::filesystem::path& dir, const eval::ArtificialScene
                    const eval::ArtificialRow& row) {
   const bool straight = scene.data == eval::ArtificialData::kStraight;
   char title[200];
-  std::snprintf(title, sizeof title, "%s data, %s ROI, spacing %d %% (%.2f m)\n%zu ROIs — TP %llu, FP %llu, FN %llu, TN %llu",
-                std::string(to_string(row.data)).c_str(), std::string(to_string(row.shape)).c_str(),
-                row.ratio_pct, row.spacing_m, row.centres.size(),
-                static_cast<unsigned long long>(row.confusion.tp),
-                static_cast<unsigned long long>(row.confusion.fp),
-                static_cast<unsigned long long>(row.confusion.fn),
+  std::snprintf(title, sizeof title,
+                "%s data, %s ROI, spacing %d %% (%.2f m)\n%zu ROIs — TP %llu, FP %llu, FN %llu, TN %llu",
+                std::string(to_string(row.data)).c_str(), std::string(to_string(row.shape)).c_str(), row.ratio_pct,
+                row.spacing_m, row.centres.size(), static_cast<unsigned long long>(row.confusion.tp),
+                static_cast<unsigned long long>(row.confusion.fp), static_cast<unsigned long long>(row.confusion.fn),
                 static_cast<unsigned long long>(row.confusion.tn));
   eval::SvgCanvas canvas = straight ? eval::SvgCanvas(-4.0, -8.0, 87.0, 8.0, 12.0, title)
                                     : eval::SvgCanvas(-4.0, -8.0, 58.0, 57.0, 12.0, title);
   std::vector<Eigen::Vector2d> xy;
   xy.reserve(scene.points.size());
-  for (const roi::PointXYZd& p : scene.points) xy.emplace_back(p.x, p.y);
+  for (const roi::PointXYZd& p : scene.points)
+    xy.emplace_back(p.x, p.y);
   draw_classified(canvas, xy, row.kept, scene.truth, 1.6);
   const bool circles = row.shape == eval::RoiShape::kCircular;
   draw_chain(canvas, row.centres, circles, circles ? eval::kCircleDiameter_m : eval::kRectHeight_m, eval::kRectWidth_m);
@@ -68,46 +68,45 @@ void print_csv_header() {
 void print_csv_row(const eval::ArtificialRow& r) {
   const roi::Confusion& c = r.confusion;
   std::printf("%s,%s,%d,%zu,%llu,%llu,%llu,%llu,%.6f,%.6f,%.6f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n",
-              std::string(to_string(r.data)).c_str(), std::string(to_string(r.shape)).c_str(),
-              r.ratio_pct, r.centres.size(), static_cast<unsigned long long>(c.tp),
-              static_cast<unsigned long long>(c.fp), static_cast<unsigned long long>(c.fn),
-              static_cast<unsigned long long>(c.tn), c.precision(), c.recall(), c.accuracy(),
-              r.reference.min_ms, r.reference.max_ms, r.reference.avg_ms, r.fast.min_ms,
-              r.fast.max_ms, r.fast.avg_ms);
+              std::string(to_string(r.data)).c_str(), std::string(to_string(r.shape)).c_str(), r.ratio_pct,
+              r.centres.size(), static_cast<unsigned long long>(c.tp), static_cast<unsigned long long>(c.fp),
+              static_cast<unsigned long long>(c.fn), static_cast<unsigned long long>(c.tn), c.precision(), c.recall(),
+              c.accuracy(), r.reference.min_ms, r.reference.max_ms, r.reference.avg_ms, r.fast.min_ms, r.fast.max_ms,
+              r.fast.avg_ms);
 }
 
 void print_table_header(eval::ArtificialData data, eval::RoiShape shape, std::size_t points, int reps) {
-  std::printf("\n%s data (%zu points), %s ROI — times over %d repetitions [ms]\n",
-              std::string(to_string(data)).c_str(), points, std::string(to_string(shape)).c_str(), reps);
-  std::printf("%6s %5s %7s %6s %7s %7s %9s %7s %8s  %-23s %-23s %7s\n", "ratio", "#ROI", "TP", "FP",
-              "FN", "TN", "precision", "recall", "accuracy", "reference min/max/avg",
-              "fast min/max/avg", "speedup");
+  std::printf("\n%s data (%zu points), %s ROI — times over %d repetitions [ms]\n", std::string(to_string(data)).c_str(),
+              points, std::string(to_string(shape)).c_str(), reps);
+  std::printf("%6s %5s %7s %6s %7s %7s %9s %7s %8s  %-23s %-23s %7s\n", "ratio", "#ROI", "TP", "FP", "FN", "TN",
+              "precision", "recall", "accuracy", "reference min/max/avg", "fast min/max/avg", "speedup");
 }
 
 void print_table_row(const eval::ArtificialRow& r) {
   const roi::Confusion& c = r.confusion;
   char reference[40];
   char fast[40];
-  std::snprintf(reference, sizeof reference, "%.3f/%.3f/%.3f", r.reference.min_ms, r.reference.max_ms, r.reference.avg_ms);
+  std::snprintf(reference, sizeof reference, "%.3f/%.3f/%.3f", r.reference.min_ms, r.reference.max_ms,
+                r.reference.avg_ms);
   std::snprintf(fast, sizeof fast, "%.3f/%.3f/%.3f", r.fast.min_ms, r.fast.max_ms, r.fast.avg_ms);
   std::printf("%5d%% %5zu %7llu %6llu %7llu %7llu %9.4f %7.4f %8.4f  %-23s %-23s %6.1fx\n", r.ratio_pct,
-              r.centres.size(), static_cast<unsigned long long>(c.tp),
-              static_cast<unsigned long long>(c.fp), static_cast<unsigned long long>(c.fn),
-              static_cast<unsigned long long>(c.tn), c.precision(), c.recall(), c.accuracy(),
-              reference, fast, r.reference.avg_ms / r.fast.avg_ms);
+              r.centres.size(), static_cast<unsigned long long>(c.tp), static_cast<unsigned long long>(c.fp),
+              static_cast<unsigned long long>(c.fn), static_cast<unsigned long long>(c.tn), c.precision(), c.recall(),
+              c.accuracy(), reference, fast, r.reference.avg_ms / r.fast.avg_ms);
 }
 
 void print_json_row(const eval::ArtificialRow& r, bool first) {
   const roi::Confusion& c = r.confusion;
-  std::printf("%s\n  {\"data\": \"%s\", \"shape\": \"%s\", \"ratio_pct\": %d, \"num_roi\": %zu, \"tp\": %llu, \"fp\": %llu, "
-              "\"fn\": %llu, \"tn\": %llu, \"precision\": %.6f, \"recall\": %.6f, \"accuracy\": %.6f, "
-              "\"fast_equals_reference\": %s, \"reference\": {\"min_ms\": %.4f, \"max_ms\": %.4f, \"avg_ms\": %.4f}, "
-              "\"fast\": {\"min_ms\": %.4f, \"max_ms\": %.4f, \"avg_ms\": %.4f}}",
-              first ? "" : ",", std::string(to_string(r.data)).c_str(), std::string(to_string(r.shape)).c_str(), r.ratio_pct,
-              r.centres.size(), static_cast<unsigned long long>(c.tp), static_cast<unsigned long long>(c.fp),
-              static_cast<unsigned long long>(c.fn), static_cast<unsigned long long>(c.tn), c.precision(), c.recall(),
-              c.accuracy(), r.fast_equals_reference ? "true" : "false", r.reference.min_ms, r.reference.max_ms,
-              r.reference.avg_ms, r.fast.min_ms, r.fast.max_ms, r.fast.avg_ms);
+  std::printf(
+      "%s\n  {\"data\": \"%s\", \"shape\": \"%s\", \"ratio_pct\": %d, \"num_roi\": %zu, \"tp\": %llu, \"fp\": %llu, "
+      "\"fn\": %llu, \"tn\": %llu, \"precision\": %.6f, \"recall\": %.6f, \"accuracy\": %.6f, "
+      "\"fast_equals_reference\": %s, \"reference\": {\"min_ms\": %.4f, \"max_ms\": %.4f, \"avg_ms\": %.4f}, "
+      "\"fast\": {\"min_ms\": %.4f, \"max_ms\": %.4f, \"avg_ms\": %.4f}}",
+      first ? "" : ",", std::string(to_string(r.data)).c_str(), std::string(to_string(r.shape)).c_str(), r.ratio_pct,
+      r.centres.size(), static_cast<unsigned long long>(c.tp), static_cast<unsigned long long>(c.fp),
+      static_cast<unsigned long long>(c.fn), static_cast<unsigned long long>(c.tn), c.precision(), c.recall(),
+      c.accuracy(), r.fast_equals_reference ? "true" : "false", r.reference.min_ms, r.reference.max_ms,
+      r.reference.avg_ms, r.fast.min_ms, r.fast.max_ms, r.fast.avg_ms);
 }
 
 void run_artificial(const ArtificialOptions& options) {
@@ -152,8 +151,8 @@ void add_eval_commands(CLI::App& app) {
   eval_cmd->require_subcommand(1);
 
   auto options = std::make_shared<ArtificialOptions>();
-  CLI::App* artificial = eval_cmd->add_subcommand(
-      "artificial", "Tables 3 and 5: circular and rectangular ROIs on the artificial frames");
+  CLI::App* artificial =
+      eval_cmd->add_subcommand("artificial", "Tables 3 and 5: circular and rectangular ROIs on the artificial frames");
   artificial->add_option("--data", options->data, "Point set")
       ->check(CLI::IsMember({"straight", "curved", "both"}))
       ->capture_default_str();

@@ -56,8 +56,10 @@ Hangup parse_hangup(const std::string& text) {
   } catch (const std::exception&) {
     throw std::invalid_argument("--hangup '" + text + "': AT_S and FOR_S must be numbers");
   }
-  if (h.stream != "gnss" && h.stream != "imu") throw std::invalid_argument("--hangup '" + text + "': stream is gnss or imu");
-  if (!(h.at_s >= 0.0) || !(h.for_s > 0.0)) throw std::invalid_argument("--hangup '" + text + "': AT_S >= 0, FOR_S > 0");
+  if (h.stream != "gnss" && h.stream != "imu")
+    throw std::invalid_argument("--hangup '" + text + "': stream is gnss or imu");
+  if (!(h.at_s >= 0.0) || !(h.for_s > 0.0))
+    throw std::invalid_argument("--hangup '" + text + "': AT_S >= 0, FOR_S > 0");
   return h;
 }
 
@@ -199,12 +201,21 @@ std::vector<std::uint8_t> malformed(std::span<const std::uint8_t> real, std::uin
   std::vector<std::uint8_t> out(real.begin(), real.end());
   out.resize(1206);  // a data packet's size, whatever came in
   switch (k % 5) {
-    case 0: out.resize(600); break;                  // wrong size
-    case 1: out.front() = 0x00; break;               // bad block flag
-    case 2: out.back() = 0x28; break;                // VLP-32C product id
-    case 3: out.resize(1400, 0xAB); break;           // oversize for a Velodyne packet
+    case 0:
+      out.resize(600);
+      break;  // wrong size
+    case 1:
+      out.front() = 0x00;
+      break;  // bad block flag
+    case 2:
+      out.back() = 0x28;
+      break;  // VLP-32C product id
+    case 3:
+      out.resize(1400, 0xAB);
+      break;  // oversize for a Velodyne packet
     default:
-      for (auto& b : out) b = static_cast<std::uint8_t>(random());  // noise
+      for (auto& b : out)
+        b = static_cast<std::uint8_t>(random());  // noise
       break;
   }
   return out;
@@ -219,12 +230,14 @@ void run_feed(const FeedOptions& o) {
   streams.gnss = !o.gnss_link.empty();
   streams.imu = !o.imu_link.empty();
   inputs::RunMerger merger(dir, streams);
-  for (const std::string& missing : merger.missing()) throw std::runtime_error(missing + ": not found");
+  for (const std::string& missing : merger.missing())
+    throw std::runtime_error(missing + ": not found");
   std::unique_ptr<PtyDevice> gnss_dev, imu_dev;
   if (streams.gnss) gnss_dev = std::make_unique<PtyDevice>("gnss", o.gnss_link);
   if (streams.imu) imu_dev = std::make_unique<PtyDevice>("imu", o.imu_link);
   std::vector<Hangup> hangups;
-  for (const std::string& h : o.hangups) hangups.push_back(parse_hangup(h));
+  for (const std::string& h : o.hangups)
+    hangups.push_back(parse_hangup(h));
   UdpSender sensor(o.from);
   std::unique_ptr<UdpSender> foreign;
   if (!o.foreign_from.empty()) foreign = std::make_unique<UdpSender>(o.foreign_from);
@@ -308,14 +321,14 @@ void run_feed(const FeedOptions& o) {
     }
     if (!wrote && !dev.write(item.bytes)) ++serial_undelivered[k];
   }
-  std::printf("feed: done: %.3f s of data in %.3f s; UDP sent %llu (%llu data, %llu flood of which %llu malformed)"
-              " from %s, %llu from %s; serial chunks with no reader: gnss %llu, imu %llu\n",
-              data_s,
-              static_cast<double>(inputs::monotonic_ns() - start) * 1e-9, static_cast<unsigned long long>(sensor.sent()),
-              static_cast<unsigned long long>(data_sent), static_cast<unsigned long long>(flood_sent),
-              static_cast<unsigned long long>(malformed_sent), o.from.c_str(),
-              static_cast<unsigned long long>(foreign_sent), o.foreign_from.empty() ? "-" : o.foreign_from.c_str(),
-              static_cast<unsigned long long>(serial_undelivered[0]), static_cast<unsigned long long>(serial_undelivered[1]));
+  std::printf(
+      "feed: done: %.3f s of data in %.3f s; UDP sent %llu (%llu data, %llu flood of which %llu malformed)"
+      " from %s, %llu from %s; serial chunks with no reader: gnss %llu, imu %llu\n",
+      data_s, static_cast<double>(inputs::monotonic_ns() - start) * 1e-9,
+      static_cast<unsigned long long>(sensor.sent()), static_cast<unsigned long long>(data_sent),
+      static_cast<unsigned long long>(flood_sent), static_cast<unsigned long long>(malformed_sent), o.from.c_str(),
+      static_cast<unsigned long long>(foreign_sent), o.foreign_from.empty() ? "-" : o.foreign_from.c_str(),
+      static_cast<unsigned long long>(serial_undelivered[0]), static_cast<unsigned long long>(serial_undelivered[1]));
   std::fflush(stdout);
   inputs::Pacer::sleep_until(inputs::monotonic_ns() + static_cast<std::int64_t>(o.linger_s * 1e9));
 }
@@ -326,12 +339,15 @@ void add_feed_command(CLI::App& app) {
   auto o = std::make_shared<FeedOptions>();
   CLI::App* cmd = app.add_subcommand(
       "feed", "Play a run folder into a live trajroid: UDP to 127.0.0.1, serial streams through pseudo-terminals");
-  cmd->add_option("run", o->run_dir, "Run folder (lidar.pcap, gnss.trjb, imu.trjb)")->required()->check(CLI::ExistingDirectory);
+  cmd->add_option("run", o->run_dir, "Run folder (lidar.pcap, gnss.trjb, imu.trjb)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
   cmd->add_option("--rate", o->rate, "Pace: 1 real time, N × real time")->capture_default_str();
   cmd->add_option("--data-port", o->data_port, "UDP port for data packets")->capture_default_str();
   cmd->add_option("--position-port", o->position_port, "UDP port for position packets")->capture_default_str();
   cmd->add_option("--from", o->from, "Loopback address the sensor sends from")->capture_default_str();
-  cmd->add_option("--gnss-link", o->gnss_link, "Symlink to create for the GNSS pseudo-terminal (the daemon's gnss.device)");
+  cmd->add_option("--gnss-link", o->gnss_link,
+                  "Symlink to create for the GNSS pseudo-terminal (the daemon's gnss.device)");
   cmd->add_option("--imu-link", o->imu_link, "Symlink to create for the IMU pseudo-terminal (the daemon's imu.device)");
   cmd->add_option("--wait-for-readers", o->wait_for_readers_s, "Seconds to wait for the devices to be opened")
       ->capture_default_str();

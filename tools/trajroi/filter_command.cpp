@@ -71,15 +71,14 @@ double spacing(const FilterOptions& o, double size_along_m) {
   }
   if (o.spacing_m) return *o.spacing_m;
   if (!std::isfinite(*o.spacing_ratio) || *o.spacing_ratio <= 0.0) {
-    throw std::invalid_argument("--spacing-ratio must be finite and positive, got " +
-                                std::to_string(*o.spacing_ratio));
+    throw std::invalid_argument("--spacing-ratio must be finite and positive, got " + std::to_string(*o.spacing_ratio));
   }
   return roi::spacing_from_ratio(*o.spacing_ratio, size_along_m);
 }
 
 template <typename RoiSet>
-roi::FilterStats run_chain(const RoiSet& set, const std::string& algorithm,
-                           std::span<const roi::PointXYZd> points, roi::IndexVector& kept) {
+roi::FilterStats run_chain(const RoiSet& set, const std::string& algorithm, std::span<const roi::PointXYZd> points,
+                           roi::IndexVector& kept) {
   if (algorithm == "reference") return roi::reference_filter(set, points, kept);
   roi::GridFilter<RoiSet> grid;
   grid.build(set);
@@ -88,10 +87,8 @@ roi::FilterStats run_chain(const RoiSet& set, const std::string& algorithm,
 
 void run_filter(const FilterOptions& o) {
   // Read and validate everything first: on any error nothing is written.
-  const roi::Trajectory trajectory =
-      roi::parse_trajectory_csv(read_text_file(o.trajectory_path), o.trajectory_path);
-  std::vector<roi::PointXYZd> points =
-      eval::parse_points_csv(read_text_file(o.points_path), o.points_path);
+  const roi::Trajectory trajectory = roi::parse_trajectory_csv(read_text_file(o.trajectory_path), o.trajectory_path);
+  std::vector<roi::PointXYZd> points = eval::parse_points_csv(read_text_file(o.points_path), o.points_path);
   const Eigen::Isometry3d global_from_sensor = parse_pose(o.pose);
   roi::transform_points(global_from_sensor, points, points);
   if (o.cloud_precision == "float") {
@@ -144,12 +141,10 @@ void run_filter(const FilterOptions& o) {
 
 void add_filter_command(CLI::App& app) {
   auto o = std::make_shared<FilterOptions>();
-  CLI::App* cmd = app.add_subcommand(
-      "filter", "Keep the points of a CSV cloud inside a trajectory ROI; write their indices");
-  cmd->add_option("--trajectory", o->trajectory_path, "Trajectory CSV: 'x,y' per line (global frame, m)")
-      ->required();
-  cmd->add_option("--points", o->points_path, "Points CSV: 'x,y,z[,intensity]' per line (sensor frame, m)")
-      ->required();
+  CLI::App* cmd =
+      app.add_subcommand("filter", "Keep the points of a CSV cloud inside a trajectory ROI; write their indices");
+  cmd->add_option("--trajectory", o->trajectory_path, "Trajectory CSV: 'x,y' per line (global frame, m)")->required();
+  cmd->add_option("--points", o->points_path, "Points CSV: 'x,y,z[,intensity]' per line (sensor frame, m)")->required();
   cmd->add_option("--shape", o->shape, "ROI method")
       ->required()
       ->check(CLI::IsMember({"circular", "rectangular", "corridor", "cuboid"}));
@@ -175,8 +170,7 @@ void add_filter_command(CLI::App& app) {
   cmd->add_option("--algorithm", o->algorithm, "Membership implementation")
       ->check(CLI::IsMember({"reference", "fast"}))
       ->capture_default_str();
-  cmd->add_option("--output-indices", o->output_path, "Write 0-based kept indices here, ascending")
-      ->required();
+  cmd->add_option("--output-indices", o->output_path, "Write 0-based kept indices here, ascending")->required();
   cmd->callback([o] { run_filter(*o); });
 }
 

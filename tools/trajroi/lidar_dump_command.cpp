@@ -48,9 +48,10 @@ class CsvSink final : public FrameSink {
   }
   void on_frame(const Frame& frame) override {
     for (const Point& p : frame.points) {
-      std::fprintf(file_.get(), "%" PRIu64 ",%.4f,%.4f,%.4f,%u,%u,%.3f,%.3f,%u,%s\n", frame.index, double{p.x},
-                   double{p.y}, double{p.z}, unsigned{p.intensity}, unsigned{p.ring}, double{p.azimuth_deg},
-                   double{p.distance_m}, p.time_offset_ns, std::string(to_string(p.return_type)).c_str());
+      std::fprintf(file_.get(), "%" PRIu64 ",%.4f,%.4f,%.4f,%u,%u,%.3f,%.3f,%u,%s\n", frame.index,
+                   static_cast<double>(p.x), static_cast<double>(p.y), static_cast<double>(p.z), unsigned{p.intensity},
+                   unsigned{p.ring}, static_cast<double>(p.azimuth_deg), static_cast<double>(p.distance_m),
+                   p.time_offset_ns, std::string(to_string(p.return_type)).c_str());
     }
   }
   void commit() {
@@ -108,9 +109,12 @@ std::string hex_byte(std::uint8_t b) {
 std::string return_mode_name(std::optional<ReturnMode> mode) {
   if (!mode) return "";
   switch (*mode) {
-    case ReturnMode::kStrongest: return "strongest";
-    case ReturnMode::kLast: return "last";
-    case ReturnMode::kDual: return "dual";
+    case ReturnMode::kStrongest:
+      return "strongest";
+    case ReturnMode::kLast:
+      return "last";
+    case ReturnMode::kDual:
+      return "dual";
   }
   return "";
 }
@@ -165,35 +169,39 @@ void run_lidar_dump(const LidarDumpOptions& o) {
         ", \"rejected_packets\": %s, \"rejection\": %s, \"model\": %s, \"product_id\": %s, \"return_mode\": %s, "
         "\"frames\": %" PRIu64 ", \"partial_frames\": %" PRIu64 ", \"points\": %" PRIu64 ", \"no_return\": %" PRIu64
         ", \"out_of_range\": %" PRIu64 ", \"lost_packets\": %" PRIu64 ", \"out_of_order\": %" PRIu64
-        ", \"duplicates\": %" PRIu64 ", \"skipped_records\": %" PRIu64 ", \"gprmc\": {\"first\": %s, \"last\": %s}, "
+        ", \"duplicates\": %" PRIu64 ", \"skipped_records\": %" PRIu64
+        ", \"gprmc\": {\"first\": %s, \"last\": %s}, "
         "\"read_error\": %s}\n",
         json_string(o.capture).c_str(), c.data_packets, c.position_packets, rejected.c_str(),
-        c.rejected_total() > 0 && !decoder.model_check().reason().empty() ? json_string(decoder.model_check().reason()).c_str()
-                                                                      : "null",
-        model.empty() ? "null" : json_string(model).c_str(),
-        product ? json_string(hex_byte(*product)).c_str() : "null",
-        decoder.return_mode() ? json_string(return_mode_name(decoder.return_mode())).c_str() : "null",
-        c.frames, c.partial_frames, c.points, c.no_return, c.out_of_range, c.lost_packets, c.out_of_order,
-        c.duplicates, source.skipped_records(), rmc_json(decoder.first_rmc()).c_str(),
-        rmc_json(decoder.last_rmc()).c_str(), read_error.empty() ? "null" : json_string(read_error).c_str());
+        c.rejected_total() > 0 && !decoder.model_check().reason().empty()
+            ? json_string(decoder.model_check().reason()).c_str()
+            : "null",
+        model.empty() ? "null" : json_string(model).c_str(), product ? json_string(hex_byte(*product)).c_str() : "null",
+        decoder.return_mode() ? json_string(return_mode_name(decoder.return_mode())).c_str() : "null", c.frames,
+        c.partial_frames, c.points, c.no_return, c.out_of_range, c.lost_packets, c.out_of_order, c.duplicates,
+        source.skipped_records(), rmc_json(decoder.first_rmc()).c_str(), rmc_json(decoder.last_rmc()).c_str(),
+        read_error.empty() ? "null" : json_string(read_error).c_str());
   } else {
     std::printf("%s\n", o.capture.c_str());
     std::printf("  data packets      %" PRIu64 " (%" PRIu64 " decoded, %" PRIu64 " rejected)\n", c.data_packets,
                 c.decoded_packets, c.rejected_total());
     for (std::size_t e = 1; e < kPacketErrorCount; ++e) {
       if (c.rejected[e] > 0) {
-        std::printf("    %-22s %" PRIu64 "\n", std::string(to_string(static_cast<PacketError>(e))).c_str(), c.rejected[e]);
+        std::printf("    %-22s %" PRIu64 "\n", std::string(to_string(static_cast<PacketError>(e))).c_str(),
+                    c.rejected[e]);
       }
     }
-    if (!decoder.model_check().reason().empty() && c.rejected_total() > 0) std::printf("    %s\n", decoder.model_check().reason().c_str());
+    if (!decoder.model_check().reason().empty() && c.rejected_total() > 0)
+      std::printf("    %s\n", decoder.model_check().reason().c_str());
     std::printf("  model             %s%s\n", model.empty() ? "-" : model.c_str(),
                 product ? (" (product id " + hex_byte(*product) + ")").c_str() : "");
-    std::printf("  return mode       %s\n", decoder.return_mode() ? return_mode_name(decoder.return_mode()).c_str() : "-");
+    std::printf("  return mode       %s\n",
+                decoder.return_mode() ? return_mode_name(decoder.return_mode()).c_str() : "-");
     std::printf("  frames            %" PRIu64 " complete, %" PRIu64 " partial\n", c.frames, c.partial_frames);
     std::printf("  points            %" PRIu64 " (no return %" PRIu64 ", out of range %" PRIu64 ")\n", c.points,
                 c.no_return, c.out_of_range);
-    std::printf("  lost packets      %" PRIu64 " (out of order %" PRIu64 ", duplicates %" PRIu64 ")\n",
-                c.lost_packets, c.out_of_order, c.duplicates);
+    std::printf("  lost packets      %" PRIu64 " (out of order %" PRIu64 ", duplicates %" PRIu64 ")\n", c.lost_packets,
+                c.out_of_order, c.duplicates);
     std::printf("  position packets  %" PRIu64 "\n", c.position_packets);
     if (decoder.first_rmc()) std::printf("  GPRMC first       %s\n", rmc_json(decoder.first_rmc()).c_str());
     if (decoder.last_rmc()) std::printf("  GPRMC last        %s\n", rmc_json(decoder.last_rmc()).c_str());

@@ -16,13 +16,13 @@
 
 #include "commands.hpp"
 #include "trajroi/eval/scenario_eval.hpp"
+#include "trajroi/inputs/capture.hpp"
 #include "trajroi/points_t.hpp"
 #include "trajroi/roi/metrics.hpp"
 #include "trajroi/roi_t.hpp"
 #include "trajroi/sim/run_folder.hpp"
 #include "trajroi/status_t.hpp"
 #include "trajroi/transport/lcm_subscribe.hpp"
-#include "trajroi/inputs/capture.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
 #include "trajroi/vlp16/stream_decoder.hpp"
 
@@ -49,7 +49,8 @@ class TruthScorer {
     if (frame == nullptr || roi.num_centres == 0) return;
     std::vector<roi::Centre> centres;
     for (std::size_t i = 0; i < roi.cx.size(); ++i) {
-      centres.push_back({{roi.cx[i], roi.cy[i]}, roi.theta_rad[i], roi.start_s_m + roi.spacing_m * static_cast<double>(i)});
+      centres.push_back(
+          {{roi.cx[i], roi.cy[i]}, roi.theta_rad[i], roi.start_s_m + roi.spacing_m * static_cast<double>(i)});
     }
     const bool circles = roi.shape == trajroi::roi_t::CIRCULAR;
     const eval::TruthCorridor corridor(run_.trajectory(), centres, circles ? 0.0 : roi.height_m / 2.0,
@@ -67,7 +68,8 @@ class TruthScorer {
     }
     std::sort(kept.begin(), kept.end());
     std::vector<std::uint8_t> truth(truth_points_.size());
-    for (std::size_t i = 0; i < truth.size(); ++i) truth[i] = corridor.contains(truth_points_[i].x, truth_points_[i].y) ? 1 : 0;
+    for (std::size_t i = 0; i < truth.size(); ++i)
+      truth[i] = corridor.contains(truth_points_[i].x, truth_points_[i].y) ? 1 : 0;
     const roi::Confusion c = roi::confusion(kept, truth);
     total_.tp += c.tp;
     total_.fp += c.fp;
@@ -91,7 +93,8 @@ class TruthScorer {
       void on_frame(const vlp16::Frame& f) override { frames->push_back(f); }
     } keep;
     keep.frames = &frames_;
-    while (!frames_.empty() && frames_.front().index < index) frames_.pop_front();
+    while (!frames_.empty() && frames_.front().index < index)
+      frames_.pop_front();
     while ((frames_.empty() || frames_.back().index < index) && !ended_) {
       ended_ = capture_.step(keep) != vlp16::PacketSource::Next::kDatagram;
     }
@@ -134,20 +137,22 @@ class Watcher {
     std::printf("trajroi watch: %zu sweeps heard", points_heard_);
     if (last_) {
       const auto& s = *last_;
-      std::printf(" of %lld published (%lld withheld without a valid pose); points in %lld, kept %lld; "
-                  "latency p50 %.3f ms p99 %.3f ms (last second); ring drops %lld",
-                  static_cast<long long>(s.sweeps_published), static_cast<long long>(s.sweeps_without_pose),
-                  static_cast<long long>(s.points_in), static_cast<long long>(s.points_kept), s.latency_ms_p50,
-                  s.latency_ms_p99, static_cast<long long>(s.ring_drops));
+      std::printf(
+          " of %lld published (%lld withheld without a valid pose); points in %lld, kept %lld; "
+          "latency p50 %.3f ms p99 %.3f ms (last second); ring drops %lld",
+          static_cast<long long>(s.sweeps_published), static_cast<long long>(s.sweeps_without_pose),
+          static_cast<long long>(s.points_in), static_cast<long long>(s.points_kept), s.latency_ms_p50,
+          s.latency_ms_p99, static_cast<long long>(s.ring_drops));
     }
     std::printf("\n");
     if (scorer_ && scorer_->scored() > 0) {
       const roi::Confusion& c = scorer_->total();
-      std::printf("trajroi watch: against the scenario's truth over %zu sweeps: precision %.4f, recall %.4f, accuracy %.4f "
-                  "(TP %llu, FP %llu, FN %llu, TN %llu)\n",
-                  scorer_->scored(), c.precision(), c.recall(), c.accuracy(),
-                  static_cast<unsigned long long>(c.tp), static_cast<unsigned long long>(c.fp),
-                  static_cast<unsigned long long>(c.fn), static_cast<unsigned long long>(c.tn));
+      std::printf(
+          "trajroi watch: against the scenario's truth over %zu sweeps: precision %.4f, recall %.4f, accuracy %.4f "
+          "(TP %llu, FP %llu, FN %llu, TN %llu)\n",
+          scorer_->scored(), c.precision(), c.recall(), c.accuracy(), static_cast<unsigned long long>(c.tp),
+          static_cast<unsigned long long>(c.fp), static_cast<unsigned long long>(c.fn),
+          static_cast<unsigned long long>(c.tn));
     }
   }
 
@@ -161,12 +166,13 @@ class Watcher {
   void on_roi(const lcm::ReceiveBuffer*, const std::string&, const trajroi::roi_t* m) { rois_[m->sweep_index] = *m; }
   void on_status(const lcm::ReceiveBuffer*, const std::string&, const trajroi::status_t* m) {
     last_ = *m;
-    std::printf("status %6.1f s: sweeps %lld published %lld withheld %lld | kept %lld of %lld | latency p99 %.2f ms | "
-                "drops %lld | pose %s\n",
-                m->uptime_s, static_cast<long long>(m->sweeps), static_cast<long long>(m->sweeps_published),
-                static_cast<long long>(m->sweeps_without_pose), static_cast<long long>(m->points_kept),
-                static_cast<long long>(m->points_in), m->latency_ms_p99, static_cast<long long>(m->ring_drops),
-                m->pose_status.c_str());
+    std::printf(
+        "status %6.1f s: sweeps %lld published %lld withheld %lld | kept %lld of %lld | latency p99 %.2f ms | "
+        "drops %lld | pose %s\n",
+        m->uptime_s, static_cast<long long>(m->sweeps), static_cast<long long>(m->sweeps_published),
+        static_cast<long long>(m->sweeps_without_pose), static_cast<long long>(m->points_kept),
+        static_cast<long long>(m->points_in), m->latency_ms_p99, static_cast<long long>(m->ring_drops),
+        m->pose_status.c_str());
     std::fflush(stdout);
     if (m->final_status) done_ = true;
   }

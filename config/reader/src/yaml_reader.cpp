@@ -17,7 +17,9 @@ struct MapReader::State {
 
 namespace {
 
-int line_of(const YAML::Node& node) { return node.Mark().line >= 0 ? node.Mark().line + 1 : 0; }
+int line_of(const YAML::Node& node) {
+  return node.Mark().line >= 0 ? node.Mark().line + 1 : 0;
+}
 
 std::string located(const std::string& source, int line) {
   return line > 0 ? source + ":" + std::to_string(line) : source;
@@ -44,7 +46,9 @@ MapReader MapReader::parse(std::string_view text, std::string source) {
   return MapReader(std::move(state));
 }
 
-const std::string& MapReader::source() const noexcept { return *state_->source; }
+const std::string& MapReader::source() const noexcept {
+  return *state_->source;
+}
 
 std::string MapReader::path(std::string_view key) const {
   std::string p = state_->prefix;
@@ -75,7 +79,9 @@ void MapReader::missing(std::string_view key) const {
   throw ConfigError(message);
 }
 
-bool MapReader::has(std::string_view key) const { return static_cast<bool>(node(key)); }
+bool MapReader::has(std::string_view key) const {
+  return static_cast<bool>(node(key));
+}
 
 YAML::Node MapReader::node(std::string_view key) const {
   for (const auto& item : state_->node) {
@@ -98,11 +104,14 @@ double MapReader::number(std::string_view key) {
   const std::string text = scalar(key).Scalar();
   double value = 0.0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc{} || end != text.data() + text.size() || !std::isfinite(value)) fail(key, "must be a finite number");
+  if (ec != std::errc{} || end != text.data() + text.size() || !std::isfinite(value))
+    fail(key, "must be a finite number");
   return value;
 }
 
-double MapReader::number(std::string_view key, double fallback) { return has(key) ? number(key) : fallback; }
+double MapReader::number(std::string_view key, double fallback) {
+  return has(key) ? number(key) : fallback;
+}
 
 double MapReader::positive(std::string_view key, double fallback) {
   const double v = number(key, fallback);
@@ -128,7 +137,9 @@ std::int64_t MapReader::integer(std::string_view key, std::int64_t fallback) {
   return has(key) ? integer(key) : fallback;
 }
 
-std::string MapReader::text(std::string_view key) { return scalar(key).Scalar(); }
+std::string MapReader::text(std::string_view key) {
+  return scalar(key).Scalar();
+}
 
 std::string MapReader::text(std::string_view key, std::string_view fallback) {
   return has(key) ? text(key) : std::string(fallback);
@@ -152,10 +163,9 @@ std::vector<double> MapReader::number_list(std::string_view key, std::size_t min
     missing(key);
   }
   state_->used.emplace(key);
-  const std::string expected = min_count == max_count
-                                   ? "a list of " + std::to_string(min_count) + " finite numbers"
-                                   : "a list of " + std::to_string(min_count) + " to " + std::to_string(max_count) +
-                                         " finite numbers";
+  const std::string expected = min_count == max_count ? "a list of " + std::to_string(min_count) + " finite numbers"
+                                                      : "a list of " + std::to_string(min_count) + " to " +
+                                                            std::to_string(max_count) + " finite numbers";
   if (!list.IsSequence() || list.size() < min_count || list.size() > max_count) fail(key, "must be " + expected);
   std::vector<double> values;
   for (const auto& item : list) {

@@ -11,15 +11,23 @@ std::int64_t clock_ns(clockid_t clock) noexcept {
 }
 }  // namespace
 
-std::int64_t monotonic_ns() noexcept { return clock_ns(CLOCK_MONOTONIC); }
-std::int64_t realtime_ns() noexcept { return clock_ns(CLOCK_REALTIME); }
+std::int64_t monotonic_ns() noexcept {
+  return clock_ns(CLOCK_MONOTONIC);
+}
+std::int64_t realtime_ns() noexcept {
+  return clock_ns(CLOCK_REALTIME);
+}
 
 std::string_view to_string(Stream stream) noexcept {
   switch (stream) {
-    case Stream::kLidarData: return "lidar data";
-    case Stream::kLidarPosition: return "lidar position";
-    case Stream::kGnss: return "gnss";
-    case Stream::kImu: return "imu";
+    case Stream::kLidarData:
+      return "lidar data";
+    case Stream::kLidarPosition:
+      return "lidar position";
+    case Stream::kGnss:
+      return "gnss";
+    case Stream::kImu:
+      return "imu";
   }
   return "?";
 }

@@ -9,8 +9,8 @@ constexpr std::size_t kMaxDatagram = 1500;  // Ethernet MTU: a VLP-16 packet is 
 // ---- UDP ------------------------------------------------------------------------------------
 
 UdpInput::UdpInput(const vlp16::UdpOptions& options) : udp_(std::make_unique<vlp16::UdpSource>(options)) {
-  describe_ = "UDP " + options.bind_address + ":" + std::to_string(udp_->data_port()) + " (data), :" +
-              std::to_string(udp_->position_port()) + " (position), from " +
+  describe_ = "UDP " + options.bind_address + ":" + std::to_string(udp_->data_port()) +
+              " (data), :" + std::to_string(udp_->position_port()) + " (position), from " +
               (options.sensor_address.empty() ? std::string("any sender") : options.sensor_address + " only");
 }
 

@@ -13,7 +13,8 @@
 namespace trajroi::inputs {
 
 Pacer::Pacer(double rate) : rate_(rate) {
-  if (!(rate >= 0.0) || !std::isfinite(rate)) throw std::invalid_argument("replay rate must be >= 0, got " + std::to_string(rate));
+  if (!(rate >= 0.0) || !std::isfinite(rate))
+    throw std::invalid_argument("replay rate must be >= 0, got " + std::to_string(rate));
 }
 
 std::int64_t Pacer::due_ns(std::int64_t recorded_ns) noexcept {

@@ -12,7 +12,9 @@ RecordedInput::RecordedInput(std::filesystem::path dir, RecordedOptions options)
 
 RecordedInput::~RecordedInput() = default;
 
-std::string RecordedInput::describe() const { return "replay of " + dir_.string(); }
+std::string RecordedInput::describe() const {
+  return "replay of " + dir_.string();
+}
 
 InputCounters RecordedInput::counters() const noexcept {
   InputCounters c;
@@ -24,7 +26,8 @@ InputCounters RecordedInput::counters() const noexcept {
 
 RecordedInput::Next RecordedInput::next(InputItem& item, std::chrono::milliseconds timeout) {
   if (missing_reported_ < merger_->missing().size()) {
-    notice_ = {Notice::Level::kWarning, "replay: " + merger_->missing()[missing_reported_++] + " absent: that stream is silent"};
+    notice_ = {Notice::Level::kWarning,
+               "replay: " + merger_->missing()[missing_reported_++] + " absent: that stream is silent"};
     return Next::kNotice;
   }
   if (!error_reported_ && !merger_->error().empty()) {

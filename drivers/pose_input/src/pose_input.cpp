@@ -6,8 +6,8 @@ namespace trajroi::pose_input {
 
 std::int64_t ClockMap::map(std::int64_t sensor_ns, std::int64_t receive_ns) noexcept {
   const std::int64_t offset = receive_ns - sensor_ns;
-  if (offset_ns_ && (sensor_ns < last_sensor_ns_ || offset - *offset_ns_ > threshold_ns_ ||
-                     *offset_ns_ - offset > threshold_ns_)) {
+  if (offset_ns_ &&
+      (sensor_ns < last_sensor_ns_ || offset - *offset_ns_ > threshold_ns_ || *offset_ns_ - offset > threshold_ns_)) {
     offset_ns_.reset();
     ++resets_;
   }

@@ -65,8 +65,8 @@ void RecordingWriter::flush() {
 // ---- ReplaySource ---------------------------------------------------------------------------
 
 ReplaySource::ReplaySource(const std::string& path, ReplayOptions options) : path_(path), options_(options) {
-  if (!(options_.speed >= 0.0) || !(options_.bytes_per_second > 0.0) || options_.chunk_bytes == 0) {
-    throw std::invalid_argument("replay " + path + ": speed must be ≥ 0, byte rate and chunk size > 0");
+  if (!(options_.bytes_per_second > 0.0) || options_.chunk_bytes == 0) {
+    throw std::invalid_argument("replay " + path + ": the byte rate and the chunk size must be > 0");
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(system_error(path, "cannot open replay file"));
@@ -77,7 +77,8 @@ ReplaySource::ReplaySource(const std::string& path, ReplayOptions options) : pat
   if (!in.read(reinterpret_cast<char*>(data_.data()), static_cast<std::streamsize>(data_.size()))) {
     throw std::runtime_error(system_error(path, "cannot read replay file"));
   }
-  recording_ = data_.size() >= sizeof kRecordingMagic && std::memcmp(data_.data(), kRecordingMagic, sizeof kRecordingMagic) == 0;
+  recording_ =
+      data_.size() >= sizeof kRecordingMagic && std::memcmp(data_.data(), kRecordingMagic, sizeof kRecordingMagic) == 0;
   if (recording_) {
     index_recording();
   } else {
@@ -105,7 +106,8 @@ void ReplaySource::index_recording() {
     const auto time_ns = static_cast<std::int64_t>(framing::le_u64(bytes, at));
     const std::uint32_t length = framing::le_u32(bytes, at + 8);
     if (length == 0 || length > kMaxRecordBytes) {
-      throw std::runtime_error(path_ + ": corrupt record at byte " + std::to_string(at) + " (length " + std::to_string(length) + ")");
+      throw std::runtime_error(path_ + ": corrupt record at byte " + std::to_string(at) + " (length " +
+                               std::to_string(length) + ")");
     }
     if (data_.size() - at - kRecordHeaderBytes < length) {
       truncated_records_ = 1;
@@ -135,9 +137,9 @@ void ReplaySource::index_raw() {
   std::size_t consumed = 0;
   std::int64_t last_time = options_.start_time_ns;
   bool have_sensor_time = false;
-  std::int64_t sensor0 = 0;     // sensor clock (ns) of the first timed frame
-  std::int64_t host0 = 0;       // host time given to it
-  std::int64_t itow_base = 0;   // week rollovers of iTOW
+  std::int64_t sensor0 = 0;    // sensor clock (ns) of the first timed frame
+  std::int64_t host0 = 0;      // host time given to it
+  std::int64_t itow_base = 0;  // week rollovers of iTOW
   std::int64_t last_itow = -1;
   std::size_t last_timed_end = 0;
   std::int64_t last_timed_time = 0;
@@ -154,7 +156,8 @@ void ReplaySource::index_raw() {
       last_timed_end = end;
       last_timed_time = t;
     } else if (have_sensor_time) {
-      t = last_timed_time + static_cast<std::int64_t>(std::llround(static_cast<double>(end - last_timed_end) * ns_per_byte));
+      t = last_timed_time +
+          static_cast<std::int64_t>(std::llround(static_cast<double>(end - last_timed_end) * ns_per_byte));
     } else {
       t = nominal(end);
     }
@@ -201,19 +204,10 @@ void ReplaySource::index_raw() {
   if (chunk_start < data_.size()) close_chunk(data_.size(), false, 0);
 }
 
-ReadStatus ReplaySource::read(Chunk& chunk, std::chrono::milliseconds timeout) {
+// Read as fast as asked: pacing is the caller's (inputs::Pacer, the one pacer).
+ReadStatus ReplaySource::read(Chunk& chunk, std::chrono::milliseconds /*timeout*/) {
   if (next_ >= spans_.size()) return ReadStatus::kEnd;
   const Span& s = spans_[next_];
-  if (options_.speed > 0.0) {
-    const std::int64_t now = monotonic_now_ns();
-    if (next_ == 0) wall_start_ns_ = now;
-    const auto due = wall_start_ns_ + static_cast<std::int64_t>(static_cast<double>(s.time_ns - spans_.front().time_ns) / options_.speed);
-    if (due > now) {
-      const std::int64_t limit = std::chrono::duration_cast<std::chrono::nanoseconds>(timeout).count();
-      std::this_thread::sleep_for(std::chrono::nanoseconds(std::min(due - now, limit)));
-      if (due - now > limit) return ReadStatus::kTimeout;
-    }
-  }
   chunk.bytes = std::span<const std::uint8_t>(data_).subspan(s.offset, s.length);
   chunk.receive_time_ns = s.time_ns;
   ++next_;

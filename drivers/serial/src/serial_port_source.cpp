@@ -34,7 +34,9 @@ std::string sp_error_text(const char* what) {
   return text;
 }
 
-std::string errno_text(const char* what) { return std::string(what) + ": " + std::strerror(errno); }
+std::string errno_text(const char* what) {
+  return std::string(what) + ": " + std::strerror(errno);
+}
 
 }  // namespace
 
@@ -97,7 +99,8 @@ class SerialPortSource::TermiosPort final : public Port {
     tio.c_cflag |= CLOCAL | CREAD;
     tio.c_iflag &= ~static_cast<tcflag_t>(IXON | IXOFF | IXANY);
     const auto rate = std::find_if(kBauds.begin(), kBauds.end(), [&](const BaudRate& b) { return b.baud == o.baud; });
-    if (cfsetispeed(&tio, rate->code) != 0 || cfsetospeed(&tio, rate->code) != 0 || tcsetattr(fd_, TCSANOW, &tio) != 0) {
+    if (cfsetispeed(&tio, rate->code) != 0 || cfsetospeed(&tio, rate->code) != 0 ||
+        tcsetattr(fd_, TCSANOW, &tio) != 0) {
       return errno_text("cannot configure port 8N1");
     }
     return {};
@@ -143,16 +146,22 @@ SerialPortSource::SerialPortSource(SerialPortOptions options)
     throw std::invalid_argument("serial port " + options_.device + ": baud rate " + std::to_string(options_.baud) +
                                 " is not one of 1200 … 921600");
   }
-  if (options_.read_buffer_bytes == 0 || options_.min_backoff.count() <= 0 || options_.max_backoff < options_.min_backoff) {
-    throw std::invalid_argument("serial port " + options_.device + ": buffer and backoff bounds must be positive and ordered");
+  if (options_.read_buffer_bytes == 0 || options_.min_backoff.count() <= 0 ||
+      options_.max_backoff < options_.min_backoff) {
+    throw std::invalid_argument("serial port " + options_.device +
+                                ": buffer and backoff bounds must be positive and ordered");
   }
 }
 
 SerialPortSource::~SerialPortSource() = default;
 
-std::string SerialPortSource::describe() const { return options_.device + " @ " + std::to_string(options_.baud); }
+std::string SerialPortSource::describe() const {
+  return options_.device + " @ " + std::to_string(options_.baud);
+}
 
-bool SerialPortSource::is_open() const noexcept { return port_ != nullptr; }
+bool SerialPortSource::is_open() const noexcept {
+  return port_ != nullptr;
+}
 
 SerialPortSource::Backend SerialPortSource::backend() const noexcept {
   return port_ ? port_->backend() : Backend::kNone;
@@ -184,13 +193,16 @@ bool SerialPortSource::try_open() {
   return true;
 }
 
-void SerialPortSource::close_port() { port_.reset(); }
+void SerialPortSource::close_port() {
+  port_.reset();
+}
 
 ReadStatus SerialPortSource::read(Chunk& chunk, std::chrono::milliseconds timeout) {
   if (!port_) {
     const std::int64_t now = monotonic_now_ns();
     if (now < next_open_ns_) {
-      const auto wait = std::min<std::int64_t>(next_open_ns_ - now, std::chrono::duration_cast<std::chrono::nanoseconds>(timeout).count());
+      const auto wait = std::min<std::int64_t>(next_open_ns_ - now,
+                                               std::chrono::duration_cast<std::chrono::nanoseconds>(timeout).count());
       std::this_thread::sleep_for(std::chrono::nanoseconds(wait));
       return ReadStatus::kTimeout;
     }

@@ -23,7 +23,8 @@ std::vector<std::uint8_t> encode_frame(std::uint8_t msg_class, std::uint8_t msg_
   frame.push_back(msg_class);
   frame.push_back(msg_id);
   put_le_u16(frame, static_cast<std::uint16_t>(payload.size()));
-  for (const std::uint8_t b : payload) frame.push_back(b);
+  for (const std::uint8_t b : payload)
+    frame.push_back(b);
   const std::uint16_t ck = fletcher8(std::span<const std::uint8_t>(frame).subspan(2));
   frame.push_back(static_cast<std::uint8_t>(ck >> 8));
   frame.push_back(static_cast<std::uint8_t>(ck & 0xFF));
@@ -34,11 +35,21 @@ std::uint32_t msgout_key(PoseMessage message, Port port) noexcept {
   // Each message has five consecutive keys in port order I2C, UART1, UART2, USB, SPI.
   std::uint32_t i2c = 0;
   switch (message) {
-    case PoseMessage::kNavPvt: i2c = 0x20910006; break;
-    case PoseMessage::kNavHpposllh: i2c = 0x20910033; break;
-    case PoseMessage::kNavRelposned: i2c = 0x2091008D; break;
-    case PoseMessage::kNavCov: i2c = 0x20910083; break;
-    case PoseMessage::kNavStatus: i2c = 0x2091001A; break;
+    case PoseMessage::kNavPvt:
+      i2c = 0x20910006;
+      break;
+    case PoseMessage::kNavHpposllh:
+      i2c = 0x20910033;
+      break;
+    case PoseMessage::kNavRelposned:
+      i2c = 0x2091008D;
+      break;
+    case PoseMessage::kNavCov:
+      i2c = 0x20910083;
+      break;
+    case PoseMessage::kNavStatus:
+      i2c = 0x2091001A;
+      break;
   }
   return i2c + static_cast<std::uint32_t>(port);
 }
@@ -51,19 +62,33 @@ std::vector<std::uint8_t> encode_cfg_valset(std::span<const std::pair<std::uint3
     const unsigned size_code = (key >> 28U) & 0x7U;
     int bytes = 0;
     switch (size_code) {
-      case 1: bytes = 1; break;  // one bit, stored in a byte
-      case 2: bytes = 1; break;
-      case 3: bytes = 2; break;
-      case 4: bytes = 4; break;
-      case 5: bytes = 8; break;
-      default: throw std::invalid_argument("CFG-VALSET: key " + std::to_string(key) + " has no valid size");
+      case 1:
+        bytes = 1;
+        break;  // one bit, stored in a byte
+      case 2:
+        bytes = 1;
+        break;
+      case 3:
+        bytes = 2;
+        break;
+      case 4:
+        bytes = 4;
+        break;
+      case 5:
+        bytes = 8;
+        break;
+      default:
+        throw std::invalid_argument("CFG-VALSET: key " + std::to_string(key) + " has no valid size");
     }
-    const std::uint64_t limit = size_code == 1 ? 1 : (bytes == 8 ? ~std::uint64_t{0} : (std::uint64_t{1} << (8 * bytes)) - 1);
+    const std::uint64_t limit =
+        size_code == 1 ? 1 : (bytes == 8 ? ~std::uint64_t{0} : (std::uint64_t{1} << (8 * bytes)) - 1);
     if (value > limit) {
-      throw std::invalid_argument("CFG-VALSET: value " + std::to_string(value) + " does not fit key " + std::to_string(key));
+      throw std::invalid_argument("CFG-VALSET: value " + std::to_string(value) + " does not fit key " +
+                                  std::to_string(key));
     }
     put_le_u32(payload, key);
-    for (int i = 0; i < bytes; ++i) payload.push_back(static_cast<std::uint8_t>(value >> (8 * i)));
+    for (int i = 0; i < bytes; ++i)
+      payload.push_back(static_cast<std::uint8_t>(value >> (8 * i)));
   }
   return encode_frame(kClassCfg, 0x8A, payload);
 }
@@ -86,11 +111,16 @@ namespace {
 
 std::uint8_t message_id(PoseMessage message) noexcept {
   switch (message) {
-    case PoseMessage::kNavPvt: return kIdNavPvt;
-    case PoseMessage::kNavHpposllh: return kIdNavHpposllh;
-    case PoseMessage::kNavRelposned: return kIdNavRelposned;
-    case PoseMessage::kNavCov: return kIdNavCov;
-    case PoseMessage::kNavStatus: return kIdNavStatus;
+    case PoseMessage::kNavPvt:
+      return kIdNavPvt;
+    case PoseMessage::kNavHpposllh:
+      return kIdNavHpposllh;
+    case PoseMessage::kNavRelposned:
+      return kIdNavRelposned;
+    case PoseMessage::kNavCov:
+      return kIdNavCov;
+    case PoseMessage::kNavStatus:
+      return kIdNavStatus;
   }
   return kIdNavPvt;
 }
@@ -106,11 +136,13 @@ std::vector<std::vector<std::uint8_t>> pose_output_configuration(Generation gene
   std::vector<std::vector<std::uint8_t>> out;
   if (generation == Generation::kF9) {
     std::vector<std::pair<std::uint32_t, std::uint64_t>> items{{kKeyRateMeas, meas_ms}, {kKeyRateNav, 1}};
-    for (const PoseMessage m : messages) items.emplace_back(msgout_key(m, port), 1);
+    for (const PoseMessage m : messages)
+      items.emplace_back(msgout_key(m, port), 1);
     out.push_back(encode_cfg_valset(items));
   } else {
     out.push_back(encode_cfg_rate(meas_ms, 1));
-    for (const PoseMessage m : messages) out.push_back(encode_cfg_msg(kClassNav, message_id(m), 1));
+    for (const PoseMessage m : messages)
+      out.push_back(encode_cfg_msg(kClassNav, message_id(m), 1));
   }
   return out;
 }

@@ -4,8 +4,8 @@
 #include <limits>
 
 #include "trajroi/framing/little_endian.hpp"
-#include "trajroi/ublox/config.hpp"
 #include "trajroi/framing/utc.hpp"
+#include "trajroi/ublox/config.hpp"
 
 namespace trajroi::ublox {
 
@@ -16,18 +16,24 @@ using framing::le_u32;
 
 std::string_view to_string(PayloadError error) noexcept {
   switch (error) {
-    case PayloadError::kNone: return "none";
-    case PayloadError::kWrongLength: return "wrong payload length";
-    case PayloadError::kUnsupportedVersion: return "unsupported message version";
+    case PayloadError::kNone:
+      return "none";
+    case PayloadError::kWrongLength:
+      return "wrong payload length";
+    case PayloadError::kUnsupportedVersion:
+      return "unsupported message version";
   }
   return "unknown";
 }
 
 std::string_view to_string(CarrierSolution solution) noexcept {
   switch (solution) {
-    case CarrierSolution::kNone: return "none";
-    case CarrierSolution::kFloat: return "float";
-    case CarrierSolution::kFixed: return "fixed";
+    case CarrierSolution::kNone:
+      return "none";
+    case CarrierSolution::kFloat:
+      return "float";
+    case CarrierSolution::kFixed:
+      return "fixed";
   }
   return "none";
 }
@@ -38,9 +44,12 @@ namespace {
 // reserved value 3 reads as "none": never claim a carrier solution the receiver did not.
 CarrierSolution carrier_solution(unsigned bits) noexcept {
   switch (bits & 0x3U) {
-    case 1: return CarrierSolution::kFloat;
-    case 2: return CarrierSolution::kFixed;
-    default: return CarrierSolution::kNone;
+    case 1:
+      return CarrierSolution::kFloat;
+    case 2:
+      return CarrierSolution::kFixed;
+    default:
+      return CarrierSolution::kNone;
   }
 }
 
@@ -62,13 +71,16 @@ struct FieldReader {
   void u32(std::size_t at, std::uint32_t& v) const noexcept { v = le_u32(p, at); }
   void i32(std::size_t at, std::int32_t& v) const noexcept { v = le_i32(p, at); }
   void flag(std::size_t at, unsigned mask, bool& v) const noexcept { v = (p[at] & mask) != 0; }
-  void carrier(std::size_t at, unsigned shift, CarrierSolution& v) const noexcept { v = carrier_solution(p[at] >> shift); }
+  void carrier(std::size_t at, unsigned shift, CarrierSolution& v) const noexcept {
+    v = carrier_solution(p[at] >> shift);
+  }
 };
 
 struct FieldWriter {
   std::vector<std::uint8_t>& p;
   void put(std::size_t at, std::uint32_t v, std::size_t bytes) const {
-    for (std::size_t k = 0; k < bytes; ++k) p[at + k] = static_cast<std::uint8_t>(v >> (8 * k));
+    for (std::size_t k = 0; k < bytes; ++k)
+      p[at + k] = static_cast<std::uint8_t>(v >> (8 * k));
   }
   void u8(std::size_t at, std::uint8_t v) const { p[at] = v; }
   void i8(std::size_t at, std::int8_t v) const { p[at] = std::bit_cast<std::uint8_t>(v); }

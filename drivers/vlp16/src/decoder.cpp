@@ -24,24 +24,25 @@ struct CosSin {
 // cos and sin of a small angle by their Taylor series.
 CosSin small_angle(double d) noexcept {
   const double d2 = d * d;
-  return {1.0 - d2 * (0.5 - d2 * (1.0 / 24.0 - d2 * (1.0 / 720.0))),
-          d * (1.0 - d2 * (1.0 / 6.0 - d2 * (1.0 / 120.0)))};
+  return {1.0 - d2 * (0.5 - d2 * (1.0 / 24.0 - d2 * (1.0 / 720.0))), d * (1.0 - d2 * (1.0 / 6.0 - d2 * (1.0 / 120.0)))};
 }
 
 }  // namespace
 
 std::string_view to_string(ReturnType type) noexcept {
   switch (type) {
-    case ReturnType::kStrongest: return "strongest";
-    case ReturnType::kLast: return "last";
-    case ReturnType::kBoth: return "both";
+    case ReturnType::kStrongest:
+      return "strongest";
+    case ReturnType::kLast:
+      return "last";
+    case ReturnType::kBoth:
+      return "both";
   }
   return "unknown";
 }
 
 Calibration Calibration::vlp16_default() {
-  static constexpr double kVerticalDeg[kLasers] = {-15, 1, -13, 3, -11, 5, -9, 7,
-                                                   -7,  9, -5,  11, -3, 13, -1, 15};
+  static constexpr double kVerticalDeg[kLasers] = {-15, 1, -13, 3, -11, 5, -9, 7, -7, 9, -5, 11, -3, 13, -1, 15};
   static constexpr double kVerticalOffset_mm[kLasers] = {11.2, -0.7, 9.7, -2.2, 8.1, -3.7, 6.6, -5.1,
                                                          5.1,  -6.6, 3.7, -8.1, 2.2, -9.7, 0.7, -11.2};
   Calibration c;
@@ -54,12 +55,13 @@ Calibration Calibration::vlp16_default() {
 
 std::array<std::uint8_t, kLasers> Calibration::rings() const {
   std::array<std::uint8_t, kLasers> order{};
-  for (std::size_t i = 0; i < kLasers; ++i) order[i] = static_cast<std::uint8_t>(i);
-  std::stable_sort(order.begin(), order.end(), [&](std::uint8_t a, std::uint8_t b) {
-    return lasers[a].vert_angle_rad < lasers[b].vert_angle_rad;
-  });
+  for (std::size_t i = 0; i < kLasers; ++i)
+    order[i] = static_cast<std::uint8_t>(i);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::uint8_t a, std::uint8_t b) { return lasers[a].vert_angle_rad < lasers[b].vert_angle_rad; });
   std::array<std::uint8_t, kLasers> ring{};
-  for (std::size_t rank = 0; rank < kLasers; ++rank) ring[order[rank]] = static_cast<std::uint8_t>(rank);
+  for (std::size_t rank = 0; rank < kLasers; ++rank)
+    ring[order[rank]] = static_cast<std::uint8_t>(rank);
   return ring;
 }
 
@@ -67,10 +69,14 @@ PacketDecoder::PacketDecoder(const Calibration& calibration, DecodeOptions optio
   const auto rings = calibration.rings();
   for (std::size_t i = 0; i < kLasers; ++i) {
     const LaserCalibration& cal = calibration.lasers[i];
-    lasers_[i] = Laser{std::cos(cal.vert_angle_rad),   std::sin(cal.vert_angle_rad),
-                       std::cos(cal.rot_correction_rad), std::sin(cal.rot_correction_rad),
-                       cal.vert_offset_m,              cal.horiz_offset_m,
-                       cal.dist_correction_m,          rings[i]};
+    lasers_[i] = Laser{std::cos(cal.vert_angle_rad),
+                       std::sin(cal.vert_angle_rad),
+                       std::cos(cal.rot_correction_rad),
+                       std::sin(cal.rot_correction_rad),
+                       cal.vert_offset_m,
+                       cal.horiz_offset_m,
+                       cal.dist_correction_m,
+                       rings[i]};
     rotation_corrected_ = rotation_corrected_ || cal.rot_correction_rad != 0.0;
   }
   for (std::size_t channel = 0; channel < kChannels; ++channel) {
@@ -78,7 +84,8 @@ PacketDecoder::PacketDecoder(const Calibration& calibration, DecodeOptions optio
     const auto in_block_ns = static_cast<std::int64_t>(channel / kLasers) * kFiringCycle_ns +
                              static_cast<std::int64_t>(channel % kLasers) * kLaserPeriod_ns;
     for (std::size_t pair = 0; pair < kBlocks; ++pair) {
-      time_ns_[pair][channel] = static_cast<std::uint32_t>(static_cast<std::int64_t>(pair) * kBlockDuration_ns + in_block_ns);
+      time_ns_[pair][channel] =
+          static_cast<std::uint32_t>(static_cast<std::int64_t>(pair) * kBlockDuration_ns + in_block_ns);
     }
   }
 }

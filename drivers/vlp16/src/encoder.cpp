@@ -21,7 +21,8 @@ void put_block(std::span<std::uint8_t> p, std::size_t block, std::uint16_t azimu
                const std::array<Echo, kChannelsPerBlock>& echoes) {
   framing::store_le_u16(p, block * kBlockBytes, kBlockFlag);
   framing::store_le_u16(p, block * kBlockBytes + 2, azimuth_cdeg);
-  for (std::size_t channel = 0; channel < kChannelsPerBlock; ++channel) put_echo(p, block, channel, echoes[channel]);
+  for (std::size_t channel = 0; channel < kChannelsPerBlock; ++channel)
+    put_echo(p, block, channel, echoes[channel]);
 }
 
 // "ddmm.mmmmm" (or "dddmm.mmmmm") of |angle|, rounded to 1e-5 minute with the carry done in
@@ -52,15 +53,20 @@ void encode_data_packet(const DataPacketHeader& header, std::span<const FiringBl
     throw std::invalid_argument("VLP-16 encoder: timestamp past the hour");
   }
   for (const FiringBlock& block : blocks) {
-    if (block.azimuth_cdeg >= kAzimuthLimit) throw std::invalid_argument("VLP-16 encoder: azimuth of 360 degrees or more");
+    if (block.azimuth_cdeg >= kAzimuthLimit)
+      throw std::invalid_argument("VLP-16 encoder: azimuth of 360 degrees or more");
   }
   const std::span<std::uint8_t> p(out);
   std::fill(p.begin(), p.end(), std::uint8_t{0});
   for (std::size_t i = 0; i < blocks.size(); ++i) {
     const FiringBlock& block = blocks[i];
     switch (header.mode) {
-      case ReturnMode::kStrongest: put_block(p, i, block.azimuth_cdeg, block.strongest); break;
-      case ReturnMode::kLast: put_block(p, i, block.azimuth_cdeg, block.last); break;
+      case ReturnMode::kStrongest:
+        put_block(p, i, block.azimuth_cdeg, block.strongest);
+        break;
+      case ReturnMode::kLast:
+        put_block(p, i, block.azimuth_cdeg, block.last);
+        break;
       case ReturnMode::kDual:
         put_block(p, 2 * i, block.azimuth_cdeg, block.last);
         put_block(p, 2 * i + 1, block.azimuth_cdeg, block.strongest);
@@ -75,7 +81,8 @@ void encode_data_packet(const DataPacketHeader& header, std::span<const FiringBl
 void encode_position_packet(std::uint32_t toh_us, PpsStatus pps, std::string_view nmea,
                             std::span<std::uint8_t, kPositionPacketBytes> out) {
   if (nmea.size() > kNmeaBytes) throw std::invalid_argument("VLP-16 encoder: NMEA sentence longer than 128 bytes");
-  if (toh_us >= static_cast<std::uint64_t>(kHour_us)) throw std::invalid_argument("VLP-16 encoder: timestamp past the hour");
+  if (toh_us >= static_cast<std::uint64_t>(kHour_us))
+    throw std::invalid_argument("VLP-16 encoder: timestamp past the hour");
   const std::span<std::uint8_t> p(out);
   std::fill(p.begin(), p.end(), std::uint8_t{0});
   framing::store_le_u32(p, kPositionTimestampOffset, toh_us);
@@ -112,7 +119,8 @@ std::string format_rmc(const Rmc& fix, double speed_knots, double course_deg) {
                 year % 100, fix.valid ? 'A' : 'N');
   s += field;
   unsigned checksum = 0;
-  for (std::size_t i = 1; i < s.size(); ++i) checksum ^= static_cast<unsigned char>(s[i]);
+  for (std::size_t i = 1; i < s.size(); ++i)
+    checksum ^= static_cast<unsigned char>(s[i]);
   std::snprintf(field, sizeof field, "*%02X\r\n", checksum);
   s += field;
   return s;

@@ -54,7 +54,9 @@ ModelCheck::Verdict ModelCheck::check(std::span<const std::uint8_t> packet) noex
   measured_period_us_ = static_cast<std::uint32_t>(delta);
 
   const double period_us = static_cast<double>(kBlocks) * kBlockDuration_us / (dual ? 2.0 : 1.0);
-  const auto near = [&](double expected) { return std::abs(static_cast<double>(delta) - expected) <= kPeriodTolerance * expected; };
+  const auto near = [&](double expected) {
+    return std::abs(static_cast<double>(delta) - expected) <= kPeriodTolerance * expected;
+  };
   const bool vlp16_period = near(period_us) || near(2.0 * period_us);  // one packet lost at most
   // Azimuth advance over one firing, read as VLP-16 timing, as a rotation rate.
   const std::size_t next_firing = dual ? 2 : 1;

@@ -10,18 +10,20 @@
 namespace trajroi::vlp16 {
 namespace {
 
-constexpr int kLinkEthernet = 1;    // DLT_EN10MB
-constexpr int kLinkRaw = 101;       // LINKTYPE_RAW (DLT_RAW differs per platform)
-constexpr int kLinkRawAlt = 12;     // DLT_RAW on Linux
-constexpr int kLinkIpv4 = 228;      // LINKTYPE_IPV4
-constexpr int kLinkSll = 113;       // LINKTYPE_LINUX_SLL
-constexpr int kLinkSll2 = 276;      // LINKTYPE_LINUX_SLL2
+constexpr int kLinkEthernet = 1;  // DLT_EN10MB
+constexpr int kLinkRaw = 101;     // LINKTYPE_RAW (DLT_RAW differs per platform)
+constexpr int kLinkRawAlt = 12;   // DLT_RAW on Linux
+constexpr int kLinkIpv4 = 228;    // LINKTYPE_IPV4
+constexpr int kLinkSll = 113;     // LINKTYPE_LINUX_SLL
+constexpr int kLinkSll2 = 276;    // LINKTYPE_LINUX_SLL2
 constexpr std::uint16_t kEtherIpv4 = 0x0800;
 constexpr std::uint16_t kEtherVlan = 0x8100;
 constexpr std::uint16_t kEtherQinQ = 0x88A8;
 constexpr std::uint8_t kIpProtoUdp = 17;
 
-std::uint16_t be16(const std::uint8_t* p) { return static_cast<std::uint16_t>((p[0] << 8) | p[1]); }
+std::uint16_t be16(const std::uint8_t* p) {
+  return static_cast<std::uint16_t>((p[0] << 8) | p[1]);
+}
 
 // Offset of the IPv4 header in a frame of this link type, or −1 when the frame is not IPv4.
 long ipv4_offset(int link, const std::uint8_t* frame, std::size_t length) {
@@ -60,49 +62,23 @@ struct PcapSource::Handle {
 
 PcapSource::PcapSource(const std::filesystem::path& path, PcapOptions options)
     : handle_(std::make_unique<Handle>()), options_(std::move(options)) {
-  if (!(options_.speed >= 0.0)) {
-    throw std::invalid_argument(path.string() + ": replay speed must be 0 (as fast as possible) or positive");
-  }
   char message[PCAP_ERRBUF_SIZE] = {};
   handle_->pcap = pcap_open_offline_with_tstamp_precision(path.c_str(), PCAP_TSTAMP_PRECISION_NANO, message);
   if (handle_->pcap == nullptr) {
     throw std::runtime_error(path.string() + ": cannot open capture: " + message);
   }
   link_type_ = pcap_datalink(handle_->pcap);
-  if (link_type_ != kLinkEthernet && link_type_ != kLinkSll && link_type_ != kLinkSll2 &&
-      link_type_ != kLinkRaw && link_type_ != kLinkRawAlt && link_type_ != kLinkIpv4) {
+  if (link_type_ != kLinkEthernet && link_type_ != kLinkSll && link_type_ != kLinkSll2 && link_type_ != kLinkRaw &&
+      link_type_ != kLinkRawAlt && link_type_ != kLinkIpv4) {
     throw std::runtime_error(path.string() + ": unsupported link type " + std::to_string(link_type_));
   }
 }
 
 PcapSource::~PcapSource() = default;
 
-PcapSource::Next PcapSource::next(Datagram& datagram, std::chrono::milliseconds timeout) {
-  if (!pending_) {
-    const Next next = read(pending_datagram_);
-    if (next != Next::kDatagram) return next;
-    pending_ = true;
-  }
-  if (options_.speed > 0.0) {
-    const auto now = std::chrono::steady_clock::now();
-    if (!paced_start_) {
-      paced_start_ = true;
-      first_record_ns_ = pending_datagram_.receive_time_ns;
-      first_delivery_ = now;
-    }
-    const auto offset_ns = static_cast<double>(pending_datagram_.receive_time_ns - first_record_ns_) / options_.speed;
-    const auto due = first_delivery_ + std::chrono::nanoseconds(static_cast<std::int64_t>(std::max(0.0, offset_ns)));
-    if (due > now) {
-      if (timeout != std::chrono::milliseconds::max() && due - now > timeout) {
-        std::this_thread::sleep_for(timeout);
-        return Next::kTimeout;
-      }
-      std::this_thread::sleep_until(due);
-    }
-  }
-  pending_ = false;
-  datagram = pending_datagram_;
-  return Next::kDatagram;
+// A capture is read as fast as asked; pacing is the caller's (inputs::Pacer, the one pacer).
+PcapSource::Next PcapSource::next(Datagram& datagram, std::chrono::milliseconds /*timeout*/) {
+  return read(datagram);
 }
 
 PcapSource::Next PcapSource::read(Datagram& datagram) {
@@ -182,21 +158,45 @@ void PcapWriter::write(std::int64_t time_ns, std::uint16_t port, std::span<const
   frame_.assign({0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0x60, 0x76, 0x88, 0x00, 0x00, 0x01, 0x08, 0x00});
   const std::size_t ip_start = frame_.size();
   const auto ip_length = static_cast<std::uint16_t>(20 + 8 + payload.size());
-  const std::uint8_t ip[20] = {0x45, 0, static_cast<std::uint8_t>(ip_length >> 8), static_cast<std::uint8_t>(ip_length),
-                               static_cast<std::uint8_t>(id_ >> 8), static_cast<std::uint8_t>(id_), 0x40, 0, 64, 17, 0, 0,
-                               192, 168, 1, 201, 255, 255, 255, 255};
+  const std::uint8_t ip[20] = {0x45,
+                               0,
+                               static_cast<std::uint8_t>(ip_length >> 8),
+                               static_cast<std::uint8_t>(ip_length),
+                               static_cast<std::uint8_t>(id_ >> 8),
+                               static_cast<std::uint8_t>(id_),
+                               0x40,
+                               0,
+                               64,
+                               17,
+                               0,
+                               0,
+                               192,
+                               168,
+                               1,
+                               201,
+                               255,
+                               255,
+                               255,
+                               255};
   ++id_;
   frame_.insert(frame_.end(), std::begin(ip), std::end(ip));
   std::uint32_t sum = 0;
-  for (std::size_t i = 0; i < 20; i += 2) sum += static_cast<std::uint32_t>(frame_[ip_start + i] << 8 | frame_[ip_start + i + 1]);
-  while (sum > 0xFFFF) sum = (sum & 0xFFFF) + (sum >> 16);
+  for (std::size_t i = 0; i < 20; i += 2)
+    sum += static_cast<std::uint32_t>(frame_[ip_start + i] << 8 | frame_[ip_start + i + 1]);
+  while (sum > 0xFFFF)
+    sum = (sum & 0xFFFF) + (sum >> 16);
   const auto checksum = static_cast<std::uint16_t>(~sum);
   frame_[ip_start + 10] = static_cast<std::uint8_t>(checksum >> 8);
   frame_[ip_start + 11] = static_cast<std::uint8_t>(checksum);
   const auto udp_length = static_cast<std::uint16_t>(8 + payload.size());
-  const std::uint8_t udp[8] = {static_cast<std::uint8_t>(port >> 8), static_cast<std::uint8_t>(port),
-                               static_cast<std::uint8_t>(port >> 8), static_cast<std::uint8_t>(port),
-                               static_cast<std::uint8_t>(udp_length >> 8), static_cast<std::uint8_t>(udp_length), 0, 0};
+  const std::uint8_t udp[8] = {static_cast<std::uint8_t>(port >> 8),
+                               static_cast<std::uint8_t>(port),
+                               static_cast<std::uint8_t>(port >> 8),
+                               static_cast<std::uint8_t>(port),
+                               static_cast<std::uint8_t>(udp_length >> 8),
+                               static_cast<std::uint8_t>(udp_length),
+                               0,
+                               0};
   frame_.insert(frame_.end(), std::begin(udp), std::end(udp));
   frame_.insert(frame_.end(), payload.begin(), payload.end());
   pcap_pkthdr header{};

@@ -34,8 +34,8 @@ bool parse_double(std::string_view text, double& out) noexcept {
 }
 
 // NMEA angle "DDDMM.mmmm" with `degree_digits` digits of degrees; hemisphere `negative` sign.
-bool parse_angle(std::string_view text, std::size_t degree_digits, std::string_view hemisphere,
-                 char positive, char negative, double limit_deg, double& out) noexcept {
+bool parse_angle(std::string_view text, std::size_t degree_digits, std::string_view hemisphere, char positive,
+                 char negative, double limit_deg, double& out) noexcept {
   int degrees = 0;
   double minutes = 0;
   if (text.size() < degree_digits + 2 || !parse_int(text.substr(0, degree_digits), degrees) ||
@@ -53,28 +53,39 @@ bool parse_angle(std::string_view text, std::size_t degree_digits, std::string_v
 
 std::string_view to_string(PpsStatus status) noexcept {
   switch (status) {
-    case PpsStatus::kAbsent: return "absent";
-    case PpsStatus::kSynchronizing: return "synchronizing";
-    case PpsStatus::kLocked: return "locked";
-    case PpsStatus::kError: return "error";
-    case PpsStatus::kUnknown: break;
+    case PpsStatus::kAbsent:
+      return "absent";
+    case PpsStatus::kSynchronizing:
+      return "synchronizing";
+    case PpsStatus::kLocked:
+      return "locked";
+    case PpsStatus::kError:
+      return "error";
+    case PpsStatus::kUnknown:
+      break;
   }
   return "unknown";
 }
 
 std::string_view to_string(NmeaError error) noexcept {
   switch (error) {
-    case NmeaError::kNone: return "none";
-    case NmeaError::kEmpty: return "empty";
-    case NmeaError::kNotRmc: return "not_rmc";
-    case NmeaError::kBadChecksum: return "bad_checksum";
-    case NmeaError::kMalformed: return "malformed";
+    case NmeaError::kNone:
+      return "none";
+    case NmeaError::kEmpty:
+      return "empty";
+    case NmeaError::kNotRmc:
+      return "not_rmc";
+    case NmeaError::kBadChecksum:
+      return "bad_checksum";
+    case NmeaError::kMalformed:
+      return "malformed";
   }
   return "unknown";
 }
 
 NmeaError parse_rmc(std::string_view sentence, Rmc& out) noexcept {
-  while (!sentence.empty() && (sentence.back() == '\n' || sentence.back() == '\r')) sentence.remove_suffix(1);
+  while (!sentence.empty() && (sentence.back() == '\n' || sentence.back() == '\r'))
+    sentence.remove_suffix(1);
   if (sentence.empty()) return NmeaError::kEmpty;
   if (sentence.front() != '$') return NmeaError::kMalformed;
   const std::size_t star = sentence.rfind('*');
@@ -83,7 +94,8 @@ NmeaError parse_rmc(std::string_view sentence, Rmc& out) noexcept {
   const int low = hex_value(sentence[star + 2]);
   if (high < 0 || low < 0) return NmeaError::kBadChecksum;
   unsigned sum = 0;
-  for (std::size_t i = 1; i < star; ++i) sum ^= static_cast<unsigned char>(sentence[i]);
+  for (std::size_t i = 1; i < star; ++i)
+    sum ^= static_cast<unsigned char>(sentence[i]);
   if (sum != static_cast<unsigned>(high * 16 + low)) return NmeaError::kBadChecksum;
 
   // $ttRMC,time,status,lat,N/S,lon,E/W,speed,course,date,…
@@ -136,7 +148,8 @@ bool parse_position_packet(std::span<const std::uint8_t> payload, PositionPacket
   p.pps = pps <= 3 ? static_cast<PpsStatus>(pps) : PpsStatus::kUnknown;
   const auto nmea = payload.subspan(kNmeaOffset, kNmeaBytes);
   std::size_t length = 0;
-  while (length < nmea.size() && nmea[length] != 0) ++length;
+  while (length < nmea.size() && nmea[length] != 0)
+    ++length;
   const std::string_view sentence(reinterpret_cast<const char*>(nmea.data()), length);
   p.nmea = parse_rmc(sentence, p.rmc);
   out = p;

@@ -21,7 +21,8 @@ std::uint32_t missing(double observed, double expected) noexcept {
 
 std::uint64_t StreamCounters::rejected_total() const noexcept {
   std::uint64_t total = 0;
-  for (const std::uint64_t n : rejected) total += n;
+  for (const std::uint64_t n : rejected)
+    total += n;
   return total;
 }
 
@@ -45,7 +46,8 @@ void StreamDecoder::on_data_packet(std::span<const std::uint8_t> payload, std::i
   }
   switch (model_.check(payload)) {
     case ModelCheck::Verdict::kVlp16:
-      for (const HeldPacket& held : held_) accept(held.bytes, held.receive_time_ns, sink);
+      for (const HeldPacket& held : held_)
+        accept(held.bytes, held.receive_time_ns, sink);
       held_.clear();
       accept(payload, receive_time_ns, sink);
       return;

@@ -115,8 +115,8 @@ bool UdpSource::receive_batch(Socket& socket) {
     header.msg_control = socket.control.data() + i * kControlBytes;
     header.msg_controllen = kControlBytes;
   }
-  const int received = recvmmsg(socket.fd, socket.headers.data(), static_cast<unsigned>(options_.batch),
-                                MSG_DONTWAIT, nullptr);
+  const int received =
+      recvmmsg(socket.fd, socket.headers.data(), static_cast<unsigned>(options_.batch), MSG_DONTWAIT, nullptr);
   if (received < 0) {
     if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
       error_ = "UDP port " + std::to_string(socket.port) + ": recvmmsg: " + std::strerror(errno);

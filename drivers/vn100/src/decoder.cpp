@@ -10,31 +10,56 @@ namespace trajroi::vn100 {
 
 std::string_view to_string(Field field) noexcept {
   switch (field) {
-    case Field::kTimeStartup: return "TimeStartup";
-    case Field::kTimeGps: return "TimeGps";
-    case Field::kTimeSyncIn: return "TimeSyncIn";
-    case Field::kYawPitchRoll: return "YawPitchRoll";
-    case Field::kQuaternion: return "Quaternion";
-    case Field::kAngularRate: return "AngularRate";
-    case Field::kAccel: return "Accel";
-    case Field::kMag: return "Mag";
-    case Field::kUncompMag: return "UncompMag";
-    case Field::kUncompAccel: return "UncompAccel";
-    case Field::kUncompGyro: return "UncompGyro";
-    case Field::kTemperature: return "Temp";
-    case Field::kPressure: return "Pres";
-    case Field::kDcm: return "DCM";
-    case Field::kMagNed: return "MagNed";
-    case Field::kAccelNed: return "AccelNed";
-    case Field::kLinearAccelBody: return "LinearAccelBody";
-    case Field::kLinearAccelNed: return "LinearAccelNed";
-    case Field::kYprUncertainty: return "YprU";
-    case Field::kVpeStatus: return "VpeStatus";
-    case Field::kImuStatus: return "ImuStatus";
-    case Field::kDeltaTheta: return "DeltaTheta";
-    case Field::kDeltaVel: return "DeltaVel";
-    case Field::kSyncInCount: return "SyncInCnt";
-    case Field::kCount: break;
+    case Field::kTimeStartup:
+      return "TimeStartup";
+    case Field::kTimeGps:
+      return "TimeGps";
+    case Field::kTimeSyncIn:
+      return "TimeSyncIn";
+    case Field::kYawPitchRoll:
+      return "YawPitchRoll";
+    case Field::kQuaternion:
+      return "Quaternion";
+    case Field::kAngularRate:
+      return "AngularRate";
+    case Field::kAccel:
+      return "Accel";
+    case Field::kMag:
+      return "Mag";
+    case Field::kUncompMag:
+      return "UncompMag";
+    case Field::kUncompAccel:
+      return "UncompAccel";
+    case Field::kUncompGyro:
+      return "UncompGyro";
+    case Field::kTemperature:
+      return "Temp";
+    case Field::kPressure:
+      return "Pres";
+    case Field::kDcm:
+      return "DCM";
+    case Field::kMagNed:
+      return "MagNed";
+    case Field::kAccelNed:
+      return "AccelNed";
+    case Field::kLinearAccelBody:
+      return "LinearAccelBody";
+    case Field::kLinearAccelNed:
+      return "LinearAccelNed";
+    case Field::kYprUncertainty:
+      return "YprU";
+    case Field::kVpeStatus:
+      return "VpeStatus";
+    case Field::kImuStatus:
+      return "ImuStatus";
+    case Field::kDeltaTheta:
+      return "DeltaTheta";
+    case Field::kDeltaVel:
+      return "DeltaVel";
+    case Field::kSyncInCount:
+      return "SyncInCnt";
+    case Field::kCount:
+      break;
   }
   return "unknown";
 }
@@ -47,7 +72,8 @@ class Reader {
 
   template <std::size_t N>
   void floats(Field field, std::array<float, N>& dst, std::size_t at) noexcept {
-    for (std::size_t i = 0; i < N; ++i) dst[i] = framing::le_f32(bytes_, at + 4 * i);
+    for (std::size_t i = 0; i < N; ++i)
+      dst[i] = framing::le_f32(bytes_, at + 4 * i);
     out_.set(field);
   }
   void scalar(Field field, float& dst, std::size_t at) noexcept {
@@ -83,7 +109,8 @@ class Writer {
 
   template <std::size_t N>
   void floats(Field, const std::array<float, N>& src, std::size_t at) noexcept {
-    for (std::size_t i = 0; i < N; ++i) put32(at + 4 * i, std::bit_cast<std::uint32_t>(src[i]));
+    for (std::size_t i = 0; i < N; ++i)
+      put32(at + 4 * i, std::bit_cast<std::uint32_t>(src[i]));
   }
   void scalar(Field, const float& v, std::size_t at) noexcept { put32(at, std::bit_cast<std::uint32_t>(v)); }
   void u64(Field, const std::uint64_t& v, std::size_t at) noexcept {
@@ -102,7 +129,8 @@ class Writer {
 
  private:
   void put32(std::size_t at, std::uint32_t v) noexcept {
-    for (std::size_t i = 0; i < 4; ++i) bytes_[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
+    for (std::size_t i = 0; i < 4; ++i)
+      bytes_[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
   }
   std::span<std::uint8_t> bytes_;
 };
@@ -111,13 +139,27 @@ class Writer {
 template <class Access, class S>
 void common_field(Access& r, S& s, unsigned bit, std::size_t at) noexcept {
   switch (bit) {
-    case 0: r.u64(Field::kTimeStartup, s.time_startup_ns, at); break;
-    case 1: r.u64(Field::kTimeGps, s.time_gps_ns, at); break;
-    case 2: r.u64(Field::kTimeSyncIn, s.time_sync_in_ns, at); break;
-    case 3: r.floats(Field::kYawPitchRoll, s.ypr_deg, at); break;
-    case 4: r.floats(Field::kQuaternion, s.quaternion_xyzw, at); break;
-    case 5: r.floats(Field::kAngularRate, s.angular_rate_rps, at); break;
-    case 8: r.floats(Field::kAccel, s.accel_mps2, at); break;
+    case 0:
+      r.u64(Field::kTimeStartup, s.time_startup_ns, at);
+      break;
+    case 1:
+      r.u64(Field::kTimeGps, s.time_gps_ns, at);
+      break;
+    case 2:
+      r.u64(Field::kTimeSyncIn, s.time_sync_in_ns, at);
+      break;
+    case 3:
+      r.floats(Field::kYawPitchRoll, s.ypr_deg, at);
+      break;
+    case 4:
+      r.floats(Field::kQuaternion, s.quaternion_xyzw, at);
+      break;
+    case 5:
+      r.floats(Field::kAngularRate, s.angular_rate_rps, at);
+      break;
+    case 8:
+      r.floats(Field::kAccel, s.accel_mps2, at);
+      break;
     case 9:  // Imu: uncompensated accel then gyro
       r.floats(Field::kUncompAccel, s.uncomp_accel_mps2, at);
       r.floats(Field::kUncompGyro, s.uncomp_gyro_rps, at + 12);
@@ -131,53 +173,107 @@ void common_field(Access& r, S& s, unsigned bit, std::size_t at) noexcept {
       r.delta_theta(s, at);
       r.floats(Field::kDeltaVel, s.delta_vel_mps, at + 16);
       break;
-    case 13: r.u32(Field::kSyncInCount, s.sync_in_count, at); break;
-    default: break;  // position, velocity, INS status: not VN-100 quantities
+    case 13:
+      r.u32(Field::kSyncInCount, s.sync_in_count, at);
+      break;
+    default:
+      break;  // position, velocity, INS status: not VN-100 quantities
   }
 }
 
 template <class Access, class S>
 void time_field(Access& r, S& s, unsigned bit, std::size_t at) noexcept {
   switch (bit) {
-    case 0: r.u64(Field::kTimeStartup, s.time_startup_ns, at); break;
-    case 1: r.u64(Field::kTimeGps, s.time_gps_ns, at); break;
-    case 4: r.u64(Field::kTimeSyncIn, s.time_sync_in_ns, at); break;
-    case 7: r.u32(Field::kSyncInCount, s.sync_in_count, at); break;
-    default: break;
+    case 0:
+      r.u64(Field::kTimeStartup, s.time_startup_ns, at);
+      break;
+    case 1:
+      r.u64(Field::kTimeGps, s.time_gps_ns, at);
+      break;
+    case 4:
+      r.u64(Field::kTimeSyncIn, s.time_sync_in_ns, at);
+      break;
+    case 7:
+      r.u32(Field::kSyncInCount, s.sync_in_count, at);
+      break;
+    default:
+      break;
   }
 }
 
 template <class Access, class S>
 void imu_field(Access& r, S& s, unsigned bit, std::size_t at) noexcept {
   switch (bit) {
-    case 0: r.u16(Field::kImuStatus, s.imu_status, at); break;
-    case 1: r.floats(Field::kUncompMag, s.uncomp_mag_gauss, at); break;
-    case 2: r.floats(Field::kUncompAccel, s.uncomp_accel_mps2, at); break;
-    case 3: r.floats(Field::kUncompGyro, s.uncomp_gyro_rps, at); break;
-    case 4: r.scalar(Field::kTemperature, s.temperature_c, at); break;
-    case 5: r.scalar(Field::kPressure, s.pressure_kpa, at); break;
-    case 6: r.delta_theta(s, at); break;
-    case 7: r.floats(Field::kDeltaVel, s.delta_vel_mps, at); break;
-    case 8: r.floats(Field::kMag, s.mag_gauss, at); break;
-    case 9: r.floats(Field::kAccel, s.accel_mps2, at); break;
-    case 10: r.floats(Field::kAngularRate, s.angular_rate_rps, at); break;
-    default: break;
+    case 0:
+      r.u16(Field::kImuStatus, s.imu_status, at);
+      break;
+    case 1:
+      r.floats(Field::kUncompMag, s.uncomp_mag_gauss, at);
+      break;
+    case 2:
+      r.floats(Field::kUncompAccel, s.uncomp_accel_mps2, at);
+      break;
+    case 3:
+      r.floats(Field::kUncompGyro, s.uncomp_gyro_rps, at);
+      break;
+    case 4:
+      r.scalar(Field::kTemperature, s.temperature_c, at);
+      break;
+    case 5:
+      r.scalar(Field::kPressure, s.pressure_kpa, at);
+      break;
+    case 6:
+      r.delta_theta(s, at);
+      break;
+    case 7:
+      r.floats(Field::kDeltaVel, s.delta_vel_mps, at);
+      break;
+    case 8:
+      r.floats(Field::kMag, s.mag_gauss, at);
+      break;
+    case 9:
+      r.floats(Field::kAccel, s.accel_mps2, at);
+      break;
+    case 10:
+      r.floats(Field::kAngularRate, s.angular_rate_rps, at);
+      break;
+    default:
+      break;
   }
 }
 
 template <class Access, class S>
 void attitude_field(Access& r, S& s, unsigned bit, std::size_t at) noexcept {
   switch (bit) {
-    case 0: r.u16(Field::kVpeStatus, s.vpe_status, at); break;
-    case 1: r.floats(Field::kYawPitchRoll, s.ypr_deg, at); break;
-    case 2: r.floats(Field::kQuaternion, s.quaternion_xyzw, at); break;
-    case 3: r.floats(Field::kDcm, s.dcm, at); break;
-    case 4: r.floats(Field::kMagNed, s.mag_ned_gauss, at); break;
-    case 5: r.floats(Field::kAccelNed, s.accel_ned_mps2, at); break;
-    case 6: r.floats(Field::kLinearAccelBody, s.linear_accel_body_mps2, at); break;
-    case 7: r.floats(Field::kLinearAccelNed, s.linear_accel_ned_mps2, at); break;
-    case 8: r.floats(Field::kYprUncertainty, s.ypr_uncertainty_deg, at); break;
-    default: break;
+    case 0:
+      r.u16(Field::kVpeStatus, s.vpe_status, at);
+      break;
+    case 1:
+      r.floats(Field::kYawPitchRoll, s.ypr_deg, at);
+      break;
+    case 2:
+      r.floats(Field::kQuaternion, s.quaternion_xyzw, at);
+      break;
+    case 3:
+      r.floats(Field::kDcm, s.dcm, at);
+      break;
+    case 4:
+      r.floats(Field::kMagNed, s.mag_ned_gauss, at);
+      break;
+    case 5:
+      r.floats(Field::kAccelNed, s.accel_ned_mps2, at);
+      break;
+    case 6:
+      r.floats(Field::kLinearAccelBody, s.linear_accel_body_mps2, at);
+      break;
+    case 7:
+      r.floats(Field::kLinearAccelNed, s.linear_accel_ned_mps2, at);
+      break;
+    case 8:
+      r.floats(Field::kYprUncertainty, s.ypr_uncertainty_deg, at);
+      break;
+    default:
+      break;
   }
 }
 
@@ -195,11 +291,20 @@ void walk(const Layout& layout, Access& access, S& sample) noexcept {
       if ((mask & (1U << bit)) == 0) continue;
       const auto group = static_cast<Group>(g);
       switch (group) {
-        case Group::kCommon: common_field(access, sample, bit, at); break;
-        case Group::kTime: time_field(access, sample, bit, at); break;
-        case Group::kImu: imu_field(access, sample, bit, at); break;
-        case Group::kAttitude: attitude_field(access, sample, bit, at); break;
-        default: break;
+        case Group::kCommon:
+          common_field(access, sample, bit, at);
+          break;
+        case Group::kTime:
+          time_field(access, sample, bit, at);
+          break;
+        case Group::kImu:
+          imu_field(access, sample, bit, at);
+          break;
+        case Group::kAttitude:
+          attitude_field(access, sample, bit, at);
+          break;
+        default:
+          break;
       }
       at += field_size(group, bit);
     }

@@ -22,11 +22,16 @@ constexpr std::array<std::uint8_t, 16> kAttitude{2, 12, 16, 36, 12, 12, 12, 12, 
 std::size_t field_size(Group group, unsigned bit) noexcept {
   if (bit >= 16) return 0;
   switch (group) {
-    case Group::kCommon: return kCommon[bit];
-    case Group::kTime: return kTime[bit];
-    case Group::kImu: return kImu[bit];
-    case Group::kAttitude: return kAttitude[bit];
-    default: return 0;  // GPS, INS, GPS2: VN-200/300 only
+    case Group::kCommon:
+      return kCommon[bit];
+    case Group::kTime:
+      return kTime[bit];
+    case Group::kImu:
+      return kImu[bit];
+    case Group::kAttitude:
+      return kAttitude[bit];
+    default:
+      return 0;  // GPS, INS, GPS2: VN-200/300 only
   }
 }
 
@@ -79,7 +84,8 @@ std::vector<std::uint8_t> encode_frame(const std::array<std::uint16_t, 8>& group
     throw std::invalid_argument("VN-100 frame: payload of " + std::to_string(payload.size()) + " bytes, layout needs " +
                                 std::to_string(layout->payload_bytes));
   }
-  for (const std::uint8_t b : payload) frame.push_back(b);
+  for (const std::uint8_t b : payload)
+    frame.push_back(b);
   const std::uint16_t crc = crc16_ccitt(std::span<const std::uint8_t>(frame).subspan(1));
   frame.push_back(static_cast<std::uint8_t>(crc >> 8));
   frame.push_back(static_cast<std::uint8_t>(crc & 0xFF));

@@ -8,7 +8,9 @@ namespace {
 
 constexpr double kDegToRad = 0.017453292519943295;
 
-Eigen::Quaterniond about(const Eigen::Vector3d& axis, double rad) { return Eigen::Quaterniond(Eigen::AngleAxisd(rad, axis)); }
+Eigen::Quaterniond about(const Eigen::Vector3d& axis, double rad) {
+  return Eigen::Quaterniond(Eigen::AngleAxisd(rad, axis));
+}
 
 // ENU_from_NED swaps x and y and negates z: a rotation by π about (1, 1, 0)/√2.
 const Eigen::Quaterniond& enu_from_ned() {
@@ -29,7 +31,8 @@ Eigen::Quaterniond enu_from_vn_ypr(double yaw_deg, double pitch_deg, double roll
                                           about(Eigen::Vector3d::UnitY(), pitch_deg * kDegToRad) *
                                           about(Eigen::Vector3d::UnitX(), roll_deg * kDegToRad);
   // Declination turns the magnetic NED frame into the true one: a rotation about down.
-  const Eigen::Quaterniond true_from_magnetic = about(Eigen::Vector3d::UnitZ(), mounting.magnetic_declination_deg * kDegToRad);
+  const Eigen::Quaterniond true_from_magnetic =
+      about(Eigen::Vector3d::UnitZ(), mounting.magnetic_declination_deg * kDegToRad);
   const Eigen::Quaterniond enu_from_imu = enu_from_ned() * true_from_magnetic * ned_from_frd * frd_from_flu();
   return (enu_from_imu * mounting.robot_from_imu.conjugate()).normalized();
 }

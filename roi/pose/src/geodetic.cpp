@@ -1,12 +1,11 @@
 #include "trajroi/pose/geodetic.hpp"
 
-#include <cmath>
-#include <stdexcept>
-#include <string>
-
 #include <GeographicLib/Constants.hpp>
 #include <GeographicLib/LocalCartesian.hpp>
 #include <GeographicLib/UTMUPS.hpp>
+#include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace trajroi::pose {
 
@@ -34,7 +33,9 @@ Eigen::Matrix3d ecef_from_enu(double lat_deg, double lon_deg) {
   return m;
 }
 
-Eigen::Matrix3d rot_z(double rad) { return Eigen::AngleAxisd(rad, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
+Eigen::Matrix3d rot_z(double rad) {
+  return Eigen::AngleAxisd(rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
 
 }  // namespace
 
@@ -85,7 +86,9 @@ GlobalFrame GlobalFrame::utm(int zone, bool northern) {
   return GlobalFrame(std::move(impl));
 }
 
-bool GlobalFrame::is_utm() const noexcept { return impl_->utm; }
+bool GlobalFrame::is_utm() const noexcept {
+  return impl_->utm;
+}
 
 Eigen::Vector3d GlobalFrame::to_global(const Geodetic& p) const {
   check_geodetic(p, "geodetic position");

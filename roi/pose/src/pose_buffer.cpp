@@ -7,18 +7,30 @@ namespace trajroi::pose {
 
 std::string_view to_string(PoseStatus status) noexcept {
   switch (status) {
-    case PoseStatus::kValid: return "valid";
-    case PoseStatus::kNoGnss: return "no GNSS fix yet";
-    case PoseStatus::kNoAttitude: return "no attitude yet";
-    case PoseStatus::kBeforeFirstSample: return "time precedes the oldest pose sample";
-    case PoseStatus::kGnssTooOld: return "newest GNSS fix too old (beyond the extrapolation limit)";
-    case PoseStatus::kAttitudeTooOld: return "newest attitude too old (beyond the extrapolation limit)";
-    case PoseStatus::kGnssGap: return "gap between GNSS fixes too long";
-    case PoseStatus::kAttitudeGap: return "gap between attitudes too long";
-    case PoseStatus::kFixTypeTooLow: return "GNSS fix type below the gate";
-    case PoseStatus::kNoGnssFixOk: return "GNSS fix not flagged gnssFixOK";
-    case PoseStatus::kAccuracyTooLow: return "GNSS horizontal accuracy worse than the gate";
-    case PoseStatus::kNotRtkFixed: return "GNSS carrier solution not fixed (RTK fixed required)";
+    case PoseStatus::kValid:
+      return "valid";
+    case PoseStatus::kNoGnss:
+      return "no GNSS fix yet";
+    case PoseStatus::kNoAttitude:
+      return "no attitude yet";
+    case PoseStatus::kBeforeFirstSample:
+      return "time precedes the oldest pose sample";
+    case PoseStatus::kGnssTooOld:
+      return "newest GNSS fix too old (beyond the extrapolation limit)";
+    case PoseStatus::kAttitudeTooOld:
+      return "newest attitude too old (beyond the extrapolation limit)";
+    case PoseStatus::kGnssGap:
+      return "gap between GNSS fixes too long";
+    case PoseStatus::kAttitudeGap:
+      return "gap between attitudes too long";
+    case PoseStatus::kFixTypeTooLow:
+      return "GNSS fix type below the gate";
+    case PoseStatus::kNoGnssFixOk:
+      return "GNSS fix not flagged gnssFixOK";
+    case PoseStatus::kAccuracyTooLow:
+      return "GNSS horizontal accuracy worse than the gate";
+    case PoseStatus::kNotRtkFixed:
+      return "GNSS carrier solution not fixed (RTK fixed required)";
   }
   return "unknown";
 }
@@ -145,7 +157,8 @@ PoseQuery PoseBuffer::pose_at(std::int64_t t_ns) const noexcept {
     if (f > 0 && ahead > 0) {
       const GnssFix& prev = fixes_.at(f - 1);
       if (a.t_ns - prev.t_ns <= gate_.max_gap_ns && check(prev.quality) == PoseStatus::kValid) {
-        const Eigen::Vector3d velocity = (a.antenna_global_m - prev.antenna_global_m) / static_cast<double>(a.t_ns - prev.t_ns);
+        const Eigen::Vector3d velocity =
+            (a.antenna_global_m - prev.antenna_global_m) / static_cast<double>(a.t_ns - prev.t_ns);
         antenna += velocity * static_cast<double>(ahead);
       }
     }

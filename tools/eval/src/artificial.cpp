@@ -14,7 +14,6 @@ std::string_view to_string(ArtificialData data) noexcept {
   return data == ArtificialData::kStraight ? "straight" : "curved";
 }
 
-
 namespace {
 
 constexpr double kGridStep_m = 0.2;
@@ -28,15 +27,16 @@ roi::Trajectory curved_trajectory() {
   waypoints.reserve(kArcChords + 2);
   for (int k = 0; k < kArcChords; ++k) {
     const double phi = std::numbers::pi / 2.0 * k / kArcChords;
-    waypoints.emplace_back(kCurveRadius_m * std::sin(phi),
-                           kCurveCentreY_m - kCurveRadius_m * std::cos(phi));
+    waypoints.emplace_back(kCurveRadius_m * std::sin(phi), kCurveCentreY_m - kCurveRadius_m * std::cos(phi));
   }
   waypoints.emplace_back(50.0, 50.0);
   waypoints.emplace_back(50.0, 53.0);
   return roi::Trajectory(std::move(waypoints));
 }
 
-double curve_rho(double x, double y) { return std::hypot(x - kCurveCentreX_m, y - kCurveCentreY_m); }
+double curve_rho(double x, double y) {
+  return std::hypot(x - kCurveCentreX_m, y - kCurveCentreY_m);
+}
 
 }  // namespace
 
@@ -70,8 +70,7 @@ ArtificialScene make_artificial_scene(ArtificialData data) {
 namespace {
 
 template <typename RoiSet>
-ArtificialRow run_with(const ArtificialScene& scene, ArtificialRow row, int reps,
-                       auto make_set) {
+ArtificialRow run_with(const ArtificialScene& scene, ArtificialRow row, int reps, auto make_set) {
   const std::span<const roi::PointXYZd> points(scene.points);
   roi::IndexVector reference_kept;
   reference_kept.reserve(points.size());
@@ -93,8 +92,7 @@ ArtificialRow run_with(const ArtificialScene& scene, ArtificialRow row, int reps
 
 }  // namespace
 
-ArtificialRow run_artificial_row(const ArtificialScene& scene, RoiShape shape, int ratio_pct,
-                                 int reps) {
+ArtificialRow run_artificial_row(const ArtificialScene& scene, RoiShape shape, int ratio_pct, int reps) {
   if (ratio_pct <= 0) throw std::invalid_argument("spacing ratio must be positive");
   ArtificialRow row{};
   row.data = scene.data;
@@ -102,8 +100,7 @@ ArtificialRow run_artificial_row(const ArtificialScene& scene, RoiShape shape, i
   row.ratio_pct = ratio_pct;
   const double size_along = shape == RoiShape::kCircular ? kCircleDiameter_m : kRectHeight_m;
   row.spacing_m = roi::spacing_from_ratio(ratio_pct / 100.0, size_along);
-  roi::place_centres(scene.trajectory, 0.0, std::numeric_limits<double>::infinity(),
-                     row.spacing_m, row.centres);
+  roi::place_centres(scene.trajectory, 0.0, std::numeric_limits<double>::infinity(), row.spacing_m, row.centres);
   if (shape == RoiShape::kCircular) {
     return run_with<roi::CircularRoiSet>(scene, std::move(row), reps, [](const auto& centres) {
       return roi::CircularRoiSet(kCircleDiameter_m / 2.0, centres);

@@ -18,8 +18,7 @@ std::vector<roi::PointXYZd> parse_points_csv(std::string_view text, std::string_
     const std::size_t fields = roi::parse_csv_doubles(content, values);
     if (fields != 3 && fields != 4) {
       throw std::runtime_error(std::string(source_name) + ":" + std::to_string(line_number) +
-                               ": expected 'x,y,z[,intensity]', got '" + std::string(content) +
-                               "'");
+                               ": expected 'x,y,z[,intensity]', got '" + std::string(content) + "'");
     }
     points.push_back({values[0], values[1], values[2]});
   });

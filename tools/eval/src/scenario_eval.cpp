@@ -2,27 +2,26 @@
 
 #include <algorithm>
 #include <array>
-#include <map>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <stdexcept>
 
+#include "trajroi/config/text_file.hpp"
 #include "trajroi/config/yaml_reader.hpp"
 #include "trajroi/daemon/sweep_processor.hpp"
+#include "trajroi/inputs/capture.hpp"
+#include "trajroi/inputs/run_merger.hpp"
 #include "trajroi/roi/grid_filter.hpp"
 #include "trajroi/roi/shapes.hpp"
 #include "trajroi/roi/transform.hpp"
-#include "trajroi/config/text_file.hpp"
-#include "trajroi/inputs/capture.hpp"
-#include "trajroi/inputs/run_merger.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
 
 namespace trajroi::eval {
 namespace fs = std::filesystem;
 namespace {
-
 
 template <typename Point>
 void push_point(std::vector<Point>& out, const Eigen::Vector3d& p, float intensity) {
@@ -54,7 +53,8 @@ RoiChain::RoiChain(const sim::EvaluationSpec& spec)
 void RoiChain::run(const roi::Trajectory& trajectory, double s0_m, double look_ahead_m, RoiShape shape, int ratio_pct,
                    std::span<const roi::PointXYZI> points) {
   const bool circular = shape == RoiShape::kCircular;
-  const double spacing = roi::spacing_from_ratio(ratio_pct / 100.0, circular ? spec_.circle_diameter_m : spec_.rect_height_m);
+  const double spacing =
+      roi::spacing_from_ratio(ratio_pct / 100.0, circular ? spec_.circle_diameter_m : spec_.rect_height_m);
   roi::place_centres(trajectory, s0_m, look_ahead_m, spacing, centres_);
   if (circular) {
     circles_.assign(centres_);
@@ -72,8 +72,8 @@ void RoiChain::run(const roi::Trajectory& trajectory, double s0_m, double look_a
 ScenarioRun::ScenarioRun(const fs::path& dir) : dir_(dir) {
   sim::require_run_folder(dir);
   scenario_ = sim::load_scenario(dir / sim::kScenarioFile);
-  trajectory_ = std::make_unique<roi::Trajectory>(
-      roi::parse_trajectory_csv(config::read_text_file(dir / sim::kTrajectoryFile), (dir / sim::kTrajectoryFile).string()));
+  trajectory_ = std::make_unique<roi::Trajectory>(roi::parse_trajectory_csv(
+      config::read_text_file(dir / sim::kTrajectoryFile), (dir / sim::kTrajectoryFile).string()));
   robot_from_lidar_ = scenario_.robot.lidar.robot_from_sensor();
   // The daemon's configuration the simulator wrote for this run: sensors, delays, ranges.
   config_ = daemon::load_daemon_config(dir / sim::kDaemonConfigFile);
@@ -157,7 +157,9 @@ vlp16::StreamCounters ScenarioRun::for_each_frame(const FrameCallback& on_frame)
   return decoder.counters();
 }
 
-std::string_view to_string(PoseMode mode) noexcept { return mode == PoseMode::kPerSweep ? "per-sweep" : "per-firing"; }
+std::string_view to_string(PoseMode mode) noexcept {
+  return mode == PoseMode::kPerSweep ? "per-sweep" : "per-firing";
+}
 
 // ---- the daemon's pipeline ------------------------------------------------------------------
 
@@ -200,13 +202,18 @@ void run_pipelines(const ScenarioRun& run, std::span<const daemon::DaemonConfig>
     for (Lane& lane : lanes) {
       daemon::SweepProcessor& p = *lane.processor;
       switch (item.stream) {
-        case inputs::Stream::kGnss: p.gnss_bytes(item.bytes, item.receive_ns); break;
-        case inputs::Stream::kImu: p.imu_bytes(item.bytes, item.receive_ns); break;
+        case inputs::Stream::kGnss:
+          p.gnss_bytes(item.bytes, item.receive_ns);
+          break;
+        case inputs::Stream::kImu:
+          p.imu_bytes(item.bytes, item.receive_ns);
+          break;
         case inputs::Stream::kLidarData:
         case inputs::Stream::kLidarPosition: {
           lane.packet_start = std::chrono::steady_clock::now();
-          p.lidar_datagram(item.stream == inputs::Stream::kLidarData ? daemon::LidarPort::kData : daemon::LidarPort::kPosition,
-                           item.bytes, item.receive_ns, lane);
+          p.lidar_datagram(
+              item.stream == inputs::Stream::kLidarData ? daemon::LidarPort::kData : daemon::LidarPort::kPosition,
+              item.bytes, item.receive_ns, lane);
           lane.sweep_ms += elapsed_ms(lane.packet_start);
           lane.packet_start = std::chrono::steady_clock::now();
           break;
@@ -232,7 +239,10 @@ void place_frame_truth(const vlp16::Frame& frame, const sim::TruthPoses& truth,
   for (const vlp16::Point& p : frame.points) {
     const sim::TruePose tp = truth.at(frame.start_time_ns + p.time_offset_ns);
     const Eigen::Isometry3d global_from_lidar = roi::pose_from_xy_yaw(tp.x_m, tp.y_m, tp.yaw_rad) * robot_from_lidar;
-    push_point(out, global_from_lidar * Eigen::Vector3d(p.x, p.y, p.z), 0.0f);
+    push_point(out,
+               global_from_lidar *
+                   Eigen::Vector3d(static_cast<double>(p.x), static_cast<double>(p.y), static_cast<double>(p.z)),
+               0.0f);
   }
 }
 
@@ -272,7 +282,8 @@ std::vector<KeyframeCase> keyframe_cases(const ScenarioRun& run, PoseMode mode) 
   });
   std::int64_t last_end = std::numeric_limits<std::int64_t>::min();
   for (std::size_t k = 0; k < cases.size(); ++k) {
-    if (found[k] == 0) throw std::runtime_error(run.dir().string() + ": no complete frame at keyframe '" + cases[k].keyframe.name + "'");
+    if (found[k] == 0)
+      throw std::runtime_error(run.dir().string() + ": no complete frame at keyframe '" + cases[k].keyframe.name + "'");
     last_end = std::max(last_end, cases[k].frame.end_time_ns);
   }
   // The keyframes' sweeps through the daemon's pipeline: their points as it places them, the
@@ -281,7 +292,8 @@ std::vector<KeyframeCase> keyframe_cases(const ScenarioRun& run, PoseMode mode) 
     std::vector<KeyframeCase>* cases;
     std::vector<std::uint8_t> placed_ok;
     std::vector<pose::PoseStatus> status;
-    void on_placed(std::size_t, const vlp16::Frame& frame, std::size_t first, std::span<const roi::PointXYZI> placed) override {
+    void on_placed(std::size_t, const vlp16::Frame& frame, std::size_t first,
+                   std::span<const roi::PointXYZI> placed) override {
       for (KeyframeCase& c : *cases) {
         if (c.frame.start_time_ns != frame.start_time_ns) continue;
         if (c.points.size() < first + placed.size()) c.points.resize(first + placed.size());
@@ -311,7 +323,8 @@ std::vector<KeyframeCase> keyframe_cases(const ScenarioRun& run, PoseMode mode) 
     }
     place_frame_truth(c.frame, run.truth(), run.robot_from_lidar(), c.truth);
     const pose::PoseQuery q = run.poses().pose_at(c.time_ns);
-    if (!q.valid()) throw std::runtime_error(run.dir().string() + ": keyframe '" + c.keyframe.name + "': no valid pose");
+    if (!q.valid())
+      throw std::runtime_error(run.dir().string() + ": keyframe '" + c.keyframe.name + "': no valid pose");
     c.robot_pose = q.global_from_robot;
   }
   return cases;
@@ -323,16 +336,19 @@ std::vector<KeyframeRow> run_keyframe_rows(const ScenarioRun& run, const std::ve
   const sim::EvaluationSpec& e = run.scenario().evaluation;
   std::vector<daemon::DaemonConfig> configs;
   for (const RoiShape shape : shapes) {
-    for (const int ratio : ratios_pct) configs.push_back(run.pipeline_config(shape, ratio, mode));
+    for (const int ratio : ratios_pct)
+      configs.push_back(run.pipeline_config(shape, ratio, mode));
   }
   std::vector<KeyframeRow> rows;
   for (const RoiShape shape : shapes) {
     for (const KeyframeCase& c : cases) {
-      for (const int ratio : ratios_pct) rows.push_back({c.keyframe.name, shape, ratio, {}, {}, {}, {}, {}});
+      for (const int ratio : ratios_pct)
+        rows.push_back({c.keyframe.name, shape, ratio, {}, {}, {}, {}, {}});
     }
   }
   std::int64_t last_end = std::numeric_limits<std::int64_t>::min();
-  for (const KeyframeCase& c : cases) last_end = std::max(last_end, c.frame.end_time_ns);
+  for (const KeyframeCase& c : cases)
+    last_end = std::max(last_end, c.frame.end_time_ns);
   // Row of configuration k (shape s, ratio r) and case c.
   const std::size_t n_ratios = ratios_pct.size();
   const auto row_of = [&](std::size_t k, std::size_t c) -> KeyframeRow& {
@@ -355,18 +371,20 @@ std::vector<KeyframeRow> run_keyframe_rows(const ScenarioRun& run, const std::ve
   collect.cases = &cases;
   collect.row = row_of;
   collect.samples.assign(rows.size(), 0);
-  for (int rep = 0; rep < std::max(reps, 1); ++rep) run_pipelines(run, configs, collect, last_end);
+  for (int rep = 0; rep < std::max(reps, 1); ++rep)
+    run_pipelines(run, configs, collect, last_end);
   for (std::size_t k = 0; k < configs.size(); ++k) {
     for (std::size_t c = 0; c < cases.size(); ++c) {
       KeyframeRow& row = row_of(k, c);
       const KeyframeCase& kc = cases[c];
       if (row.centres.empty()) {
-        throw std::runtime_error(run.dir().string() + ": keyframe '" + kc.keyframe.name + "': the pipeline gave no chain");
+        throw std::runtime_error(run.dir().string() + ": keyframe '" + kc.keyframe.name +
+                                 "': the pipeline gave no chain");
       }
       const bool circles = row.shape == RoiShape::kCircular;
       const double half_a = circles ? 0.0 : e.rect_height_m / 2.0;
-      const TruthCorridor corridor(run.trajectory(), row.centres, half_a, circles ? e.circle_diameter_m : e.rect_width_m,
-                                   !circles);
+      const TruthCorridor corridor(run.trajectory(), row.centres, half_a,
+                                   circles ? e.circle_diameter_m : e.rect_width_m, !circles);
       row.truth.resize(kc.truth.size());
       for (std::size_t i = 0; i < kc.truth.size(); ++i) {
         row.truth[i] = corridor.contains(kc.truth[i].x, kc.truth[i].y) ? 1 : 0;
@@ -392,7 +410,7 @@ SequentialReport run_sequential(const ScenarioRun& run, PoseMode mode, int ratio
                                                     run.pipeline_config(RoiShape::kRectangular, ratio_pct, mode)};
   struct Collect final : PipelineObserver {
     SequentialReport report;
-    std::map<std::uint64_t, FrameTiming> frames;  // complete sweeps with a valid pose, by index
+    std::map<std::uint64_t, FrameTiming> frames;   // complete sweeps with a valid pose, by index
     std::map<std::uint64_t, std::int64_t> starts;  // every complete sweep's start (the data cycle)
     std::size_t n_circ = 0, n_rect = 0;
     void on_sweep(std::size_t k, const daemon::Sweep& sweep, double ms) override {
@@ -486,7 +504,8 @@ AccumulatedReport run_accumulated(const ScenarioRun& run, PoseMode mode, int rat
     const ScenarioRun* run = nullptr;
     int ratio_pct = 25;
     std::vector<roi::PointXYZI> placed;  // the sweep in progress, in the global frame
-    void on_placed(std::size_t, const vlp16::Frame& frame, std::size_t first, std::span<const roi::PointXYZI> points) override {
+    void on_placed(std::size_t, const vlp16::Frame& frame, std::size_t first,
+                   std::span<const roi::PointXYZI> points) override {
       if (first == 0 || placed.size() > first) placed.clear();
       if (placed.size() < frame.points.size()) placed.reserve(frame.points.size());
       placed.insert(placed.end(), points.begin(), points.end());
@@ -517,7 +536,8 @@ AccumulatedReport run_accumulated(const ScenarioRun& run, PoseMode mode, int rat
       placed.clear();
     }
   } collect;
-  for (const int n : kAccumulations) collect.acc.push_back({n, 0, {}, {0, 0}, 0.0, {}});
+  for (const int n : kAccumulations)
+    collect.acc.push_back({n, 0, {}, {0, 0}, 0.0, {}});
   RoiChain chain(run.scenario().evaluation);
   collect.chain = &chain;
   collect.run = &run;
@@ -529,8 +549,8 @@ AccumulatedReport run_accumulated(const ScenarioRun& run, PoseMode mode, int rat
     const int k = shape == RoiShape::kCircular ? 0 : 1;
     for (const Accumulator& a : collect.acc) {
       if (a.clouds[k] == 0) continue;
-      report.rows.push_back({shape, a.frames_per_cloud, a.clouds[k], a.points_sum / static_cast<double>(a.clouds[k]),
-                             a.time[k]});
+      report.rows.push_back(
+          {shape, a.frames_per_cloud, a.clouds[k], a.points_sum / static_cast<double>(a.clouds[k]), a.time[k]});
     }
   }
   report.circular_fit = fit_line(report.circular_samples);

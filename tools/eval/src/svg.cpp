@@ -17,10 +17,17 @@ std::string escape(std::string_view text) {
   std::string out;
   for (const char c : text) {
     switch (c) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      default: out += c;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '&':
+        out += "&amp;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -28,8 +35,7 @@ std::string escape(std::string_view text) {
 
 }  // namespace
 
-SvgCanvas::SvgCanvas(double x_min, double y_min, double x_max, double y_max, double px_per_m,
-                     std::string_view title)
+SvgCanvas::SvgCanvas(double x_min, double y_min, double x_max, double y_max, double px_per_m, std::string_view title)
     : x_min_(x_min),
       y_max_(y_max),
       scale_(px_per_m),
@@ -39,34 +45,31 @@ SvgCanvas::SvgCanvas(double x_min, double y_min, double x_max, double y_max, dou
 
 void SvgCanvas::dot(double x, double y, std::string_view colour, double size_px) {
   append_format(body_, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"%.*s\"/>\n",
-                px(x) - size_px / 2, py(y) - size_px / 2, size_px, size_px,
-                static_cast<int>(colour.size()), colour.data());
+                px(x) - size_px / 2, py(y) - size_px / 2, size_px, size_px, static_cast<int>(colour.size()),
+                colour.data());
 }
 
-void SvgCanvas::circle(double cx, double cy, double radius_m, std::string_view colour,
-                       double width_px) {
+void SvgCanvas::circle(double cx, double cy, double radius_m, std::string_view colour, double width_px) {
   append_format(overlay_,
                 "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"%.2f\" fill=\"none\" stroke=\"%.*s\" "
                 "stroke-width=\"%.1f\" stroke-opacity=\"0.7\"/>\n",
-                px(cx), py(cy), radius_m * scale_, static_cast<int>(colour.size()), colour.data(),
-                width_px);
+                px(cx), py(cy), radius_m * scale_, static_cast<int>(colour.size()), colour.data(), width_px);
 }
 
-void SvgCanvas::path_element(const char* tag, std::span<const Eigen::Vector2d> points,
-                             std::string_view colour, double width_px, double opacity) {
+void SvgCanvas::path_element(const char* tag, std::span<const Eigen::Vector2d> points, std::string_view colour,
+                             double width_px, double opacity) {
   append_format(overlay_, "<%s points=\"", tag);
-  for (const Eigen::Vector2d& p : points) append_format(overlay_, "%.2f,%.2f ", px(p.x()), py(p.y()));
+  for (const Eigen::Vector2d& p : points)
+    append_format(overlay_, "%.2f,%.2f ", px(p.x()), py(p.y()));
   append_format(overlay_, "\" fill=\"none\" stroke=\"%.*s\" stroke-width=\"%.1f\" stroke-opacity=\"%.2f\"/>\n",
                 static_cast<int>(colour.size()), colour.data(), width_px, opacity);
 }
 
-void SvgCanvas::polygon(std::span<const Eigen::Vector2d> corners, std::string_view colour,
-                        double width_px) {
+void SvgCanvas::polygon(std::span<const Eigen::Vector2d> corners, std::string_view colour, double width_px) {
   path_element("polygon", corners, colour, width_px, 0.7);
 }
 
-void SvgCanvas::polyline(std::span<const Eigen::Vector2d> points, std::string_view colour,
-                         double width_px) {
+void SvgCanvas::polyline(std::span<const Eigen::Vector2d> points, std::string_view colour, double width_px) {
   path_element("polyline", points, colour, width_px, 1.0);
 }
 
@@ -75,8 +78,7 @@ void SvgCanvas::legend(std::string_view colour, std::string_view label) {
   append_format(overlay_,
                 "<rect x=\"%.1f\" y=\"%.1f\" width=\"10\" height=\"10\" fill=\"%.*s\"/>"
                 "<text x=\"%.1f\" y=\"%.1f\" font-size=\"12\" font-family=\"sans-serif\">",
-                legend_x_, kRowY, static_cast<int>(colour.size()), colour.data(), legend_x_ + 14.0,
-                kRowY + 9.5);
+                legend_x_, kRowY, static_cast<int>(colour.size()), colour.data(), legend_x_ + 14.0, kRowY + 9.5);
   overlay_ += escape(label);
   overlay_ += "</text>\n";
   legend_x_ += 24.0 + 6.5 * static_cast<double>(label.size());
@@ -110,7 +112,8 @@ std::string side_by_side(std::span<const SvgCanvas> panels) {
     height = std::max(height, p.height_px());
   }
   std::string out;
-  append_format(out, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\">\n",
+  append_format(out,
+                "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\">\n",
                 width, height, width, height);
   double x = 0.0;
   for (const SvgCanvas& p : panels) {
@@ -124,10 +127,12 @@ std::string side_by_side(std::span<const SvgCanvas> panels) {
 void draw_classified(SvgCanvas& canvas, std::span<const Eigen::Vector2d> points, std::span<const std::uint32_t> kept,
                      std::span<const std::uint8_t> truth, double dot_px) {
   std::vector<std::uint8_t> kept_mask(points.size(), 0);
-  for (const std::uint32_t i : kept) kept_mask[i] = 1;
+  for (const std::uint32_t i : kept)
+    kept_mask[i] = 1;
   for (std::size_t i = 0; i < points.size(); ++i) {
     const bool in_truth = truth[i] != 0;
-    const std::string_view colour = kept_mask[i] != 0 ? (in_truth ? kColourTp : kColourFp) : (in_truth ? kColourFn : kColourTn);
+    const std::string_view colour =
+        kept_mask[i] != 0 ? (in_truth ? kColourTp : kColourFp) : (in_truth ? kColourFn : kColourTn);
     canvas.dot(points[i].x(), points[i].y(), colour, dot_px);
   }
   canvas.legend(kColourTp, "TP: kept, in the ground-truth corridor");
@@ -143,7 +148,8 @@ void draw_chain(SvgCanvas& canvas, std::span<const roi::Centre> centres, bool ci
       canvas.circle(c.position.x(), c.position.y(), diameter_or_height_m / 2.0, kColourRoi);
       continue;
     }
-    const Eigen::Vector2d u = diameter_or_height_m / 2.0 * Eigen::Vector2d(std::cos(c.theta_rad), std::sin(c.theta_rad));
+    const Eigen::Vector2d u =
+        diameter_or_height_m / 2.0 * Eigen::Vector2d(std::cos(c.theta_rad), std::sin(c.theta_rad));
     const Eigen::Vector2d v = width_m / 2.0 * Eigen::Vector2d(-std::sin(c.theta_rad), std::cos(c.theta_rad));
     const Eigen::Vector2d corners[4] = {c.position - u - v, c.position - u + v, c.position + u + v, c.position + u - v};
     canvas.polygon(corners, kColourRoi);
@@ -209,19 +215,25 @@ std::string SvgChart::str() const {
                 kLeft, kTop, pw, ph);
   const double xs = tick_step(x1 - x0), ys = tick_step(y1 - y0);
   for (double t = std::ceil(x0 / xs) * xs; t <= x1 + 1e-9 * xs; t += xs) {
-    append_format(out, "<text x=\"%.1f\" y=\"%.0f\" font-size=\"11\" font-family=\"sans-serif\" text-anchor=\"middle\">%g</text>\n",
-                  px(t), kTop + ph + 16, t);
+    append_format(
+        out,
+        "<text x=\"%.1f\" y=\"%.0f\" font-size=\"11\" font-family=\"sans-serif\" text-anchor=\"middle\">%g</text>\n",
+        px(t), kTop + ph + 16, t);
   }
   for (double t = 0.0; t <= y1 + 1e-9 * ys; t += ys) {
-    append_format(out, "<line x1=\"%.0f\" x2=\"%.0f\" y1=\"%.1f\" y2=\"%.1f\" stroke=\"#ddd\"/>"
-                  "<text x=\"%.0f\" y=\"%.1f\" font-size=\"11\" font-family=\"sans-serif\" text-anchor=\"end\">%g</text>\n",
-                  kLeft, kLeft + pw, py(t), py(t), kLeft - 6, py(t) + 4, t);
+    append_format(
+        out,
+        "<line x1=\"%.0f\" x2=\"%.0f\" y1=\"%.1f\" y2=\"%.1f\" stroke=\"#ddd\"/>"
+        "<text x=\"%.0f\" y=\"%.1f\" font-size=\"11\" font-family=\"sans-serif\" text-anchor=\"end\">%g</text>\n",
+        kLeft, kLeft + pw, py(t), py(t), kLeft - 6, py(t) + 4, t);
   }
   append_format(out, "<text x=\"%.0f\" y=\"%.0f\" font-size=\"12\" font-family=\"sans-serif\" text-anchor=\"middle\">",
                 kLeft + pw / 2, kHeight - 10);
   out += x_label_;
-  append_format(out, "</text>\n<text x=\"16\" y=\"%.0f\" font-size=\"12\" font-family=\"sans-serif\" "
-                "text-anchor=\"middle\" transform=\"rotate(-90 16 %.0f)\">", kTop + ph / 2, kTop + ph / 2);
+  append_format(out,
+                "</text>\n<text x=\"16\" y=\"%.0f\" font-size=\"12\" font-family=\"sans-serif\" "
+                "text-anchor=\"middle\" transform=\"rotate(-90 16 %.0f)\">",
+                kTop + ph / 2, kTop + ph / 2);
   out += y_label_;
   out += "</text>\n";
   double legend_x = kLeft;
@@ -232,10 +244,12 @@ std::string SvgChart::str() const {
       }
     } else {
       append_format(out, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"1\" points=\"", s.colour.c_str());
-      for (const auto& [x, y] : s.points) append_format(out, "%.1f,%.1f ", px(x), py(y));
+      for (const auto& [x, y] : s.points)
+        append_format(out, "%.1f,%.1f ", px(x), py(y));
       out += "\"/>\n";
     }
-    append_format(out, "<rect x=\"%.0f\" y=\"34\" width=\"10\" height=\"10\" fill=\"%s\"/>"
+    append_format(out,
+                  "<rect x=\"%.0f\" y=\"34\" width=\"10\" height=\"10\" fill=\"%s\"/>"
                   "<text x=\"%.0f\" y=\"43\" font-size=\"12\" font-family=\"sans-serif\">",
                   legend_x, s.colour.c_str(), legend_x + 14);
     out += s.name;

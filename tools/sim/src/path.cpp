@@ -44,10 +44,10 @@ std::vector<Eigen::Vector2d> Path::polyline(double max_chord_m) const {
   std::vector<Eigen::Vector2d> points{at(0.0).position_m};
   for (const Piece& p : pieces_) {
     const double length = p.length_m();
-    const int steps = p.segment.kind == PathSegment::Kind::kLine
-                          ? 1
-                          : std::max(1, static_cast<int>(std::ceil(length / max_chord_m)));
-    for (int k = 1; k <= steps; ++k) points.push_back(at(p.s0_m + length * k / steps).position_m);
+    const int steps =
+        p.segment.kind == PathSegment::Kind::kLine ? 1 : std::max(1, static_cast<int>(std::ceil(length / max_chord_m)));
+    for (int k = 1; k <= steps; ++k)
+      points.push_back(at(p.s0_m + length * k / steps).position_m);
   }
   return points;
 }

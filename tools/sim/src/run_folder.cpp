@@ -1,6 +1,5 @@
 #include "trajroi/sim/run_folder.hpp"
 
-
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -12,8 +11,8 @@
 
 #include "trajroi/framing/little_endian.hpp"
 #include "trajroi/serial/byte_log.hpp"
-#include "trajroi/vlp16/pcap_source.hpp"
 #include "trajroi/vlp16/packet_source.hpp"
+#include "trajroi/vlp16/pcap_source.hpp"
 
 namespace trajroi::sim {
 namespace fs = std::filesystem;
@@ -56,7 +55,9 @@ class BinaryFile {
   std::FILE* file_;
 };
 
-void append_f64(std::vector<std::uint8_t>& out, double v) { framing::put_le_u64(out, std::bit_cast<std::uint64_t>(v)); }
+void append_f64(std::vector<std::uint8_t>& out, double v) {
+  framing::put_le_u64(out, std::bit_cast<std::uint64_t>(v));
+}
 
 std::vector<std::uint8_t> read_all(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
@@ -146,38 +147,37 @@ std::string daemon_config(const Scenario& s) {
   const Mounting& m = s.robot.lidar;
   const auto& e = s.evaluation;
   char text[4096];
-  std::snprintf(
-      text, sizeof text,
-      "# trajroid configuration written by `trajroi sim` for scenario '%s'.\n"
-      "# Replays this folder: trajroid --config <this folder>/trajroid.yaml --replay <this folder>\n"
-      "# Relative paths are relative to this file.\n"
-      "global_frame:\n"
-      "  origin: {lat_deg: %.9f, lon_deg: %.9f, height_m: %.4f}\n"
-      "trajectory:\n"
-      "  file: %s\n"
-      "lidar:\n"
-      "  model: VLP-16\n"
-      "  mounting: {xyz: [%.4f, %.4f, %.4f], roll_deg: %.4f, pitch_deg: %.4f, yaw_deg: %.4f}\n"
-      "  min_range_m: %.3f\n"
-      "  max_range_m: %.3f\n"
-      "gnss:\n"
-      "  antenna: [%.4f, %.4f, %.4f]\n"
-      "  delay_s: %.6f    # epoch → receipt of its NAV-PVT (latency + transmission)\n"
-      "imu:\n"
-      "  magnetic_declination_deg: %.4f\n"
-      "  delay_s: %.6f    # sample → receipt of its frame\n"
-      "roi:\n"
-      "  shape: circular\n"
-      "  circle_diameter_m: %.3f\n"
-      "  rect_height_m: %.3f\n"
-      "  rect_width_m: %.3f\n"
-      "  spacing_ratio: 0.25\n"
-      "  look_ahead_m: %.3f\n",
-      s.name.c_str(), s.origin.lat_deg, s.origin.lon_deg, s.origin.height_m, kTrajectoryFile, m.xyz_m.x(), m.xyz_m.y(),
-      m.xyz_m.z(), m.roll_rad * kRadToDeg, m.pitch_rad * kRadToDeg, m.yaw_rad * kRadToDeg, s.lidar.min_range_m,
-      s.lidar.max_range_m, s.robot.gnss_antenna_m.x(), s.robot.gnss_antenna_m.y(), s.robot.gnss_antenna_m.z(),
-      gnss_delay_s(s.gnss), s.imu.magnetic_declination_deg, imu_delay_s(s.imu), e.circle_diameter_m, e.rect_height_m,
-      e.rect_width_m, e.look_ahead_m);
+  std::snprintf(text, sizeof text,
+                "# trajroid configuration written by `trajroi sim` for scenario '%s'.\n"
+                "# Replays this folder: trajroid --config <this folder>/trajroid.yaml --replay <this folder>\n"
+                "# Relative paths are relative to this file.\n"
+                "global_frame:\n"
+                "  origin: {lat_deg: %.9f, lon_deg: %.9f, height_m: %.4f}\n"
+                "trajectory:\n"
+                "  file: %s\n"
+                "lidar:\n"
+                "  model: VLP-16\n"
+                "  mounting: {xyz: [%.4f, %.4f, %.4f], roll_deg: %.4f, pitch_deg: %.4f, yaw_deg: %.4f}\n"
+                "  min_range_m: %.3f\n"
+                "  max_range_m: %.3f\n"
+                "gnss:\n"
+                "  antenna: [%.4f, %.4f, %.4f]\n"
+                "  delay_s: %.6f    # epoch → receipt of its NAV-PVT (latency + transmission)\n"
+                "imu:\n"
+                "  magnetic_declination_deg: %.4f\n"
+                "  delay_s: %.6f    # sample → receipt of its frame\n"
+                "roi:\n"
+                "  shape: circular\n"
+                "  circle_diameter_m: %.3f\n"
+                "  rect_height_m: %.3f\n"
+                "  rect_width_m: %.3f\n"
+                "  spacing_ratio: 0.25\n"
+                "  look_ahead_m: %.3f\n",
+                s.name.c_str(), s.origin.lat_deg, s.origin.lon_deg, s.origin.height_m, kTrajectoryFile, m.xyz_m.x(),
+                m.xyz_m.y(), m.xyz_m.z(), m.roll_rad * kRadToDeg, m.pitch_rad * kRadToDeg, m.yaw_rad * kRadToDeg,
+                s.lidar.min_range_m, s.lidar.max_range_m, s.robot.gnss_antenna_m.x(), s.robot.gnss_antenna_m.y(),
+                s.robot.gnss_antenna_m.z(), gnss_delay_s(s.gnss), s.imu.magnetic_declination_deg, imu_delay_s(s.imu),
+                e.circle_diameter_m, e.rect_height_m, e.rect_width_m, e.look_ahead_m);
   return text;
 }
 
@@ -222,10 +222,11 @@ RunReport write_run(const Scenario& scenario, const std::string& scenario_text, 
                   "wall_s              %.3f\n"
                   "realtime_factor     %.2f\n",
                   scenario.name.c_str(), static_cast<double>(st.duration_ns) * 1e-9, simulator.path().length_m(),
-                  static_cast<unsigned long long>(st.data_packets), static_cast<unsigned long long>(st.position_packets),
-                  static_cast<unsigned long long>(st.rays), static_cast<unsigned long long>(st.points),
-                  static_cast<unsigned long long>(st.points_in_corridor), static_cast<unsigned long long>(st.gnss_epochs),
-                  static_cast<unsigned long long>(st.imu_frames), report.wall_s, report.realtime_factor());
+                  static_cast<unsigned long long>(st.data_packets),
+                  static_cast<unsigned long long>(st.position_packets), static_cast<unsigned long long>(st.rays),
+                  static_cast<unsigned long long>(st.points), static_cast<unsigned long long>(st.points_in_corridor),
+                  static_cast<unsigned long long>(st.gnss_epochs), static_cast<unsigned long long>(st.imu_frames),
+                  report.wall_s, report.realtime_factor());
     write_text(temp / kSummaryFile, summary);
     if (fs::exists(target)) fs::remove_all(target);
     fs::rename(temp, target);
@@ -276,14 +277,15 @@ std::vector<std::uint8_t> read_truth_labels(const fs::path& file) {
     throw std::runtime_error(file.string() + ": its size does not match its point count");
   }
   std::vector<std::uint8_t> labels(count);
-  for (std::uint64_t i = 0; i < count; ++i) labels[i] = static_cast<std::uint8_t>((unsigned{b[24 + i / 8]} >> (i % 8)) & 1U);
+  for (std::uint64_t i = 0; i < count; ++i)
+    labels[i] = static_cast<std::uint8_t>((unsigned{b[24 + i / 8]} >> (i % 8)) & 1U);
   return labels;
 }
 
 void require_run_folder(const fs::path& dir) {
   if (!fs::is_directory(dir)) throw std::runtime_error(dir.string() + ": not a folder");
-  for (const char* name : {kScenarioFile, kLidarFile, kGnssFile, kImuFile, kTrajectoryFile, kTruthPosesFile,
-                           kTruthLabelsFile}) {
+  for (const char* name :
+       {kScenarioFile, kLidarFile, kGnssFile, kImuFile, kTrajectoryFile, kTruthPosesFile, kTruthLabelsFile}) {
     if (!fs::is_regular_file(dir / name)) {
       throw std::runtime_error(dir.string() + ": not a scenario run folder (no " + name +
                                "; make one with `trajroi sim --scenario FILE.yaml --out DIR`)");

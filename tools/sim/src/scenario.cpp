@@ -120,16 +120,18 @@ LidarSpec read_lidar(MapReader l) {
   lidar.rpm = l.number("rpm", lidar.rpm);
   l.require(lidar.rpm >= 300.0 && lidar.rpm <= 1200.0, "rpm", "must be 300 … 1200 (a VLP-16 spins at 5 … 20 Hz)");
   const std::string mode = l.choice("return_mode", {"strongest", "last", "dual"}, "strongest");
-  lidar.return_mode = mode == "dual" ? vlp16::ReturnMode::kDual
+  lidar.return_mode = mode == "dual"   ? vlp16::ReturnMode::kDual
                       : mode == "last" ? vlp16::ReturnMode::kLast
                                        : vlp16::ReturnMode::kStrongest;
   lidar.min_range_m = l.non_negative("min_range_m", lidar.min_range_m);
   lidar.max_range_m = l.positive("max_range_m", lidar.max_range_m);
-  l.require(lidar.max_range_m <= kMaxVlp16Range_m, "max_range_m", "must be at most 131.07 m (the packet's 16-bit range)");
+  l.require(lidar.max_range_m <= kMaxVlp16Range_m, "max_range_m",
+            "must be at most 131.07 m (the packet's 16-bit range)");
   l.require(lidar.max_range_m > lidar.min_range_m, "max_range_m", "must be above min_range_m");
   lidar.range_noise_m = l.non_negative("range_noise_m", 0.0);
   lidar.start_azimuth_deg = l.number("start_azimuth_deg", 0.0);
-  l.require(lidar.start_azimuth_deg >= 0.0 && lidar.start_azimuth_deg < 360.0, "start_azimuth_deg", "must be in [0, 360)");
+  l.require(lidar.start_azimuth_deg >= 0.0 && lidar.start_azimuth_deg < 360.0, "start_azimuth_deg",
+            "must be in [0, 360)");
   l.finish();
   return lidar;
 }
@@ -150,7 +152,9 @@ GnssSpec read_gnss(MapReader g) {
   g.each("faults", [&](MapReader& f) {
     GnssFault fault;
     const std::string kind = f.choice("kind", {"lost", "no_rtk", "float"}, "lost");
-    fault.kind = kind == "lost" ? GnssFault::Kind::kLost : kind == "float" ? GnssFault::Kind::kFloat : GnssFault::Kind::kNoRtk;
+    fault.kind = kind == "lost"    ? GnssFault::Kind::kLost
+                 : kind == "float" ? GnssFault::Kind::kFloat
+                                   : GnssFault::Kind::kNoRtk;
     fault.from_s = f.non_negative("from_s", 0.0);
     fault.to_s = f.number("to_s");
     f.require(fault.to_s > fault.from_s, "to_s", "must be after from_s");
@@ -171,7 +175,8 @@ ImuSpec read_imu(MapReader i) {
   imu.latency_s = i.non_negative("latency_s", 0.0);
   i.require(imu.latency_s < 1.0, "latency_s", "must be below 1 s");
   imu.baud = i.positive("baud", imu.baud);
-  i.require(imu.baud / 10.0 >= static_cast<double>(kImuFrameBytes) * 800.0 / imu.rate_divisor, "baud", "too slow for this output rate");
+  i.require(imu.baud / 10.0 >= static_cast<double>(kImuFrameBytes) * 800.0 / imu.rate_divisor, "baud",
+            "too slow for this output rate");
   imu.angle_noise_deg = i.non_negative("angle_noise_deg", 0.0);
   imu.gyro_noise_rps = i.non_negative("gyro_noise_rps", 0.0);
   imu.accel_noise_mps2 = i.non_negative("accel_noise_mps2", 0.0);
@@ -252,8 +257,8 @@ Scenario parse_scenario(std::string_view yaml_text, const std::string& source) {
   s.seed = static_cast<std::uint64_t>(seed);
   const std::string start = root.text("start_utc");
   root.require(parse_utc_iso8601(start, s.start_utc_ns), "start_utc", "must be a UTC time like 2024-05-14T09:00:00Z");
-  root.require(s.start_utc_ns >= 315'964'800'000'000'000 && s.start_utc_ns < 3'471'292'800'000'000'000,
-               "start_utc", "must be between 1980-01-06 (the GPS epoch) and 2079");
+  root.require(s.start_utc_ns >= 315'964'800'000'000'000 && s.start_utc_ns < 3'471'292'800'000'000'000, "start_utc",
+               "must be between 1980-01-06 (the GPS epoch) and 2079");
   const config::Origin origin = config::read_origin(root.map("origin"));
   s.origin = pose::Geodetic{origin.lat_deg, origin.lon_deg, origin.height_m};
   s.world = read_world(root.map("world"));

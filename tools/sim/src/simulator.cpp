@@ -91,10 +91,18 @@ struct Simulator::Impl {
 
 Simulator::Simulator(const Scenario& scenario) : impl_(std::make_unique<Impl>(scenario)) {}
 Simulator::~Simulator() = default;
-const Scenario& Simulator::scenario() const noexcept { return impl_->scenario; }
-const Path& Simulator::path() const noexcept { return impl_->path; }
-const std::string& Simulator::trajectory_csv() const noexcept { return impl_->csv; }
-const roi::Trajectory& Simulator::trajectory() const noexcept { return impl_->trajectory; }
+const Scenario& Simulator::scenario() const noexcept {
+  return impl_->scenario;
+}
+const Path& Simulator::path() const noexcept {
+  return impl_->path;
+}
+const std::string& Simulator::trajectory_csv() const noexcept {
+  return impl_->csv;
+}
+const roi::Trajectory& Simulator::trajectory() const noexcept {
+  return impl_->trajectory;
+}
 
 SimulationStats Simulator::run(SimulationSink& sink, const std::function<void(double)>& progress) const {
   SimulationStats stats;
@@ -120,7 +128,7 @@ void Simulator::Impl::position_packet(SimulationSink& sink, std::int64_t pps_utc
 }
 
 void Simulator::Impl::run_lidar(SimulationSink& sink, SimulationStats& stats,
-                                 const std::function<void(double)>& progress) const {
+                                const std::function<void(double)>& progress) const {
   const LidarSpec& lidar = scenario.lidar;
   const std::size_t blocks_per_packet = vlp16::firing_blocks_per_packet(lidar.return_mode);
   const std::int64_t period_ns = static_cast<std::int64_t>(blocks_per_packet) * vlp16::kBlockDuration_ns;
@@ -158,7 +166,9 @@ void Simulator::Impl::run_lidar(SimulationSink& sink, SimulationStats& stats,
       next_pps += kSecond_ns;
     }
     for (std::size_t b = 0; b < blocks_per_packet; ++b) {
-      const double a = lidar.start_azimuth_deg * 100.0 + static_cast<double>(t_first + static_cast<std::int64_t>(b) * vlp16::kBlockDuration_ns) * cdeg_per_ns;
+      const double a =
+          lidar.start_azimuth_deg * 100.0 +
+          static_cast<double>(t_first + static_cast<std::int64_t>(b) * vlp16::kBlockDuration_ns) * cdeg_per_ns;
       azimuth[b] = static_cast<std::uint16_t>(std::llround(a) % vlp16::kAzimuthLimit);
     }
     measured.clear();
@@ -170,26 +180,29 @@ void Simulator::Impl::run_lidar(SimulationSink& sink, SimulationStats& stats,
       vlp16::FiringBlock& block = blocks[b];
       block.azimuth_cdeg = azimuth[b];
       for (std::size_t seq = 0; seq < vlp16::kFiringsPerBlock; ++seq) {
-        const std::int64_t t_seq = t_first + static_cast<std::int64_t>(b) * vlp16::kBlockDuration_ns + static_cast<std::int64_t>(seq) * vlp16::kFiringCycle_ns;
+        const std::int64_t t_seq = t_first + static_cast<std::int64_t>(b) * vlp16::kBlockDuration_ns +
+                                   static_cast<std::int64_t>(seq) * vlp16::kFiringCycle_ns;
         const RobotState at_seq = motion.at(t_seq);
         sink.firing_pose({scenario.start_utc_ns + t_seq, at_seq.position_m.x(), at_seq.position_m.y(), at_seq.yaw_rad});
         for (std::size_t l = 0; l < vlp16::kLasers; ++l) {
           const std::size_t channel = seq * vlp16::kLasers + l;
           const std::int64_t t = t_seq + static_cast<std::int64_t>(l) * vlp16::kLaserPeriod_ns;
-          const double theta = (static_cast<double>(azimuth[b]) + gap * vlp16::azimuth_fraction(channel)) * (kDegToRad / 100.0);
+          const double theta =
+              (static_cast<double>(azimuth[b]) + gap * vlp16::azimuth_fraction(channel)) * (kDegToRad / 100.0);
           const LaserRay& laser = lasers[l];
           const double ct = std::cos(theta), st = std::sin(theta);
           // Sensor frame (the decoder's model): p = R d + o.
           const Eigen::Vector3d d_s(laser.cos_vert * ct, -laser.cos_vert * st, laser.sin_vert);
-          const Eigen::Vector3d o_s(-laser.vert_offset_m * laser.sin_vert * ct, laser.vert_offset_m * laser.sin_vert * st,
-                                    laser.vert_offset_m * laser.cos_vert);
+          const Eigen::Vector3d o_s(-laser.vert_offset_m * laser.sin_vert * ct,
+                                    laser.vert_offset_m * laser.sin_vert * st, laser.vert_offset_m * laser.cos_vert);
           const Eigen::Isometry3d global_from_lidar = robot_pose(motion.at(t)) * robot_from_lidar;
           const Eigen::Vector3d o = global_from_lidar * o_s;
           const Eigen::Vector3d d = global_from_lidar.linear() * d_s;
           ++stats.rays;
           vlp16::Echo echo;
           if (const auto hit = world.cast(o, d, lidar.max_range_m + 5.0 * lidar.range_noise_m)) {
-            const double range = hit->range_m + (lidar.range_noise_m > 0.0 ? lidar.range_noise_m * range_noise(rng) : 0.0);
+            const double range =
+                hit->range_m + (lidar.range_noise_m > 0.0 ? lidar.range_noise_m * range_noise(rng) : 0.0);
             const long long raw = std::llround(range / vlp16::kDistanceUnit_m);
             if (range >= lidar.min_range_m && range <= lidar.max_range_m && raw >= 1 && raw <= 65535) {
               echo = {static_cast<std::uint16_t>(raw), hit->reflectivity};
@@ -211,7 +224,8 @@ void Simulator::Impl::run_lidar(SimulationSink& sink, SimulationStats& stats,
 
     corridor_grid.filter(std::span<const roi::PointXYZd>(measured), kept);
     labels.assign(measured.size(), 0);
-    for (const std::uint32_t i : kept) labels[i] = 1;
+    for (const std::uint32_t i : kept)
+      labels[i] = 1;
     sink.point_labels(labels);
     stats.points += measured.size();
     stats.points_in_corridor += kept.size();
@@ -236,7 +250,8 @@ void Simulator::Impl::run_gnss(SimulationSink& sink, SimulationStats& stats) con
     const std::int64_t utc = gps + kGpsEpochUtc_ns - kGpsMinusUtc_ns;
     const std::int64_t t = utc - scenario.start_utc_ns;
     if (t >= duration) break;
-    error = phi * error + drive * Eigen::Vector3d(g.noise_h_m * unit(rng), g.noise_h_m * unit(rng), g.noise_v_m * unit(rng));
+    error = phi * error +
+            drive * Eigen::Vector3d(g.noise_h_m * unit(rng), g.noise_h_m * unit(rng), g.noise_v_m * unit(rng));
     const GnssFault* fault = nullptr;
     for (const GnssFault& f : g.faults) {
       if (static_cast<double>(t) * 1e-9 >= f.from_s && static_cast<double>(t) * 1e-9 < f.to_s) {
@@ -274,9 +289,9 @@ void Simulator::Impl::run_gnss(SimulationSink& sink, SimulationStats& stats) con
     pvt.fix_type_raw = lost ? 0 : 3;
     pvt.gnss_fix_ok = !lost;
     pvt.diff_soln = fault == nullptr || fault->kind == GnssFault::Kind::kFloat;
-    pvt.carr_soln = fault == nullptr ? ublox::CarrierSolution::kFixed
+    pvt.carr_soln = fault == nullptr                         ? ublox::CarrierSolution::kFixed
                     : fault->kind == GnssFault::Kind::kFloat ? ublox::CarrierSolution::kFloat
-                                                              : ublox::CarrierSolution::kNone;
+                                                             : ublox::CarrierSolution::kNone;
     pvt.num_sv = lost ? 0 : 18;
     pvt.invalid_llh = lost;
     const std::int64_t lat_e9 = lost ? 0 : std::llround(where.lat_deg * 1e9);
@@ -330,7 +345,9 @@ void Simulator::Impl::run_imu(SimulationSink& sink, SimulationStats& stats) cons
   const std::int64_t duration = motion.duration_ns();
   std::mt19937_64 rng(scenario.seed * 3 + 2);
   std::normal_distribution<double> unit(0.0, 1.0);
-  const auto noisy = [&](double value, double sigma) { return static_cast<float>(sigma > 0.0 ? value + sigma * unit(rng) : value); };
+  const auto noisy = [&](double value, double sigma) {
+    return static_cast<float>(sigma > 0.0 ? value + sigma * unit(rng) : value);
+  };
 
   for (std::int64_t t = 0; t < duration; t += period_ns) {
     const RobotState state = motion.at(t);

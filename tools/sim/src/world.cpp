@@ -64,7 +64,8 @@ World::World(const WorldSpec& spec, double cell_m) : ground_reflectivity_(spec.g
     const auto item = k < boxes_.size() ? static_cast<std::uint32_t>(k)
                                         : (static_cast<std::uint32_t>(k - boxes_.size()) | kCylinderBit);
     for (int j = j0; j <= j1; ++j) {
-      for (int i = i0; i <= i1; ++i) cells[static_cast<std::size_t>(j * nx_ + i)].push_back(item);
+      for (int i = i0; i <= i1; ++i)
+        cells[static_cast<std::size_t>(j * nx_ + i)].push_back(item);
     }
   }
   cell_start_.reserve(cells.size() + 1);

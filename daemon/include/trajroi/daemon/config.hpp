@@ -28,8 +28,8 @@ enum class SchedPolicy : std::uint8_t { kOther, kFifo, kRr };
 
 struct ThreadConfig {
   SchedPolicy policy = SchedPolicy::kOther;
-  int priority = 0;        // 1 … 99 for fifo / rr
-  std::vector<int> cpus;   // affinity; empty: any
+  int priority = 0;       // 1 … 99 for fifo / rr
+  std::vector<int> cpus;  // affinity; empty: any
 };
 
 struct DaemonConfig {
@@ -91,15 +91,15 @@ struct DaemonConfig {
   } lcm;
 
   struct Buffers {
-    std::size_t lidar_packets = 4096;    // ≈ 2.7 s of dual-return packets
+    std::size_t lidar_packets = 4096;  // ≈ 2.7 s of dual-return packets
     std::size_t serial_chunks = 1024;
     std::size_t sweeps = 8;
     std::size_t max_points_per_sweep = 131072;  // a 5 Hz dual-return sweep is ≈ 115 000
   } buffers;
 
   struct Logging {
-    std::string level = "info";           // trace debug info warn error critical off
-    double warning_interval_s = 5.0;      // per-packet warnings: at most one per interval and kind
+    std::string level = "info";       // trace debug info warn error critical off
+    double warning_interval_s = 5.0;  // per-packet warnings: at most one per interval and kind
   } logging;
 
   struct Realtime {

@@ -10,8 +10,8 @@
 
 #include "trajroi/daemon/config.hpp"
 #include "trajroi/daemon/sweep_processor.hpp"
-#include "trajroi/pose/geodetic.hpp"
 #include "trajroi/points_t.hpp"
+#include "trajroi/pose/geodetic.hpp"
 #include "trajroi/pose_t.hpp"
 #include "trajroi/roi_t.hpp"
 #include "trajroi/trajectory_t.hpp"
@@ -30,8 +30,8 @@ enum class TrajectoryReject : std::uint8_t {
   kTooFewWaypoints,  // fewer than 2 (or fewer than 2 distinct)
   kTooManyWaypoints,
   kNonFinite,
-  kOutOfRange,       // latitude beyond ±90°, longitude beyond ±180°
-  kUndecodable,      // bytes that are not a trajectory_t
+  kOutOfRange,   // latitude beyond ±90°, longitude beyond ±180°
+  kUndecodable,  // bytes that are not a trajectory_t
 };
 inline constexpr std::size_t kTrajectoryRejectCount = 8;
 [[nodiscard]] std::string_view to_string(TrajectoryReject reason) noexcept;

@@ -65,14 +65,14 @@ struct Sweep {
   // The pose: `filtered` only when it was valid for every point.
   bool filtered = false;
   pose::PoseStatus pose_status = pose::PoseStatus::kNoGnss;
-  std::int64_t pose_t_ns = 0;           // sweep start
-  PublishedPose robot;                  // global_from_robot at the start
-  PublishedPose sensor;                 // global_from_lidar at the start (used for the whole
-                                        // sweep in per-sweep mode)
-  double speed_mps = 0.0;               // over the last 0.5 s (0.2 s, 0.1 s after a pose gap)
-  bool speed_known = false;             // false: the pose valid for less than 0.1 s (speed_mps 0)
-  pose::FixQuality fix;                 // newest fix at the sweep's start
-  std::int64_t fix_t_ns = 0;            // its time (0: none)
+  std::int64_t pose_t_ns = 0;  // sweep start
+  PublishedPose robot;         // global_from_robot at the start
+  PublishedPose sensor;        // global_from_lidar at the start (used for the whole
+                               // sweep in per-sweep mode)
+  double speed_mps = 0.0;      // over the last 0.5 s (0.2 s, 0.1 s after a pose gap)
+  bool speed_known = false;    // false: the pose valid for less than 0.1 s (speed_mps 0)
+  pose::FixQuality fix;        // newest fix at the sweep's start
+  std::int64_t fix_t_ns = 0;   // its time (0: none)
 
   // The ROI chain.
   std::int32_t trajectory_id = 0;
@@ -128,10 +128,13 @@ class SweepProcessor {
   SweepProcessor(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> trajectory);
   ~SweepProcessor();
 
-  void lidar_datagram(LidarPort port, std::span<const std::uint8_t> payload, std::int64_t receive_ns,
-                      SweepSink& sink);
-  void gnss_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) { pose_input_.gnss_bytes(bytes, receive_ns); }
-  void imu_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) { pose_input_.imu_bytes(bytes, receive_ns); }
+  void lidar_datagram(LidarPort port, std::span<const std::uint8_t> payload, std::int64_t receive_ns, SweepSink& sink);
+  void gnss_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) {
+    pose_input_.gnss_bytes(bytes, receive_ns);
+  }
+  void imu_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) {
+    pose_input_.imu_bytes(bytes, receive_ns);
+  }
   // Steady-clock time the next datagram entered the daemon: a sweep keeps that of the last
   // datagram that gave it points (for the latency figures; no effect on the output).
   void set_input_arrival(std::int64_t steady_ns) noexcept { arrival_ns_ = steady_ns; }
@@ -159,8 +162,8 @@ class SweepProcessor {
   void start_sweep(const vlp16::Frame& frame);
   void add_points(const vlp16::Frame& frame, std::size_t first, SweepSink& sink);
   void end_sweep(const vlp16::Frame& frame, SweepSink& sink);
-  void filter_run(const vlp16::Frame& frame, std::size_t first, std::size_t end, const Eigen::Isometry3d& global_from_lidar,
-                  SweepSink& sink);
+  void filter_run(const vlp16::Frame& frame, std::size_t first, std::size_t end,
+                  const Eigen::Isometry3d& global_from_lidar, SweepSink& sink);
 
   DaemonConfig config_;
   vlp16::StreamDecoder decoder_;

@@ -25,8 +25,8 @@ inline constexpr std::size_t kMaxCentres = 1'000'000;
 // s0 + look_ahead. `out` is cleared and refilled; its capacity is reused, so a warm caller allocates
 // nothing. Throws std::invalid_argument when spacing_m is not finite and positive, when
 // look_ahead_m is negative or NaN, or when the chain would exceed kMaxCentres.
-void place_centres(const Trajectory& trajectory, double s0_m, double look_ahead_m,
-                   double spacing_m, std::vector<Centre>& out);
+void place_centres(const Trajectory& trajectory, double s0_m, double look_ahead_m, double spacing_m,
+                   std::vector<Centre>& out);
 
 // The paper gives the spacing as a ratio of the ROI's size along the trajectory: the
 // diameter 2r for circles, the height a for rectangles (150 % → d = 1.5 · size).

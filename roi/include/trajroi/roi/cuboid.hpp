@@ -22,8 +22,7 @@ struct CuboidExtent {
 };
 
 // A box of the given length (along x), width (along y) centred on the robot, with z limits.
-[[nodiscard]] CuboidExtent centred_cuboid(double length_m, double width_m, double z_min_m,
-                                          double z_max_m);
+[[nodiscard]] CuboidExtent centred_cuboid(double length_m, double width_m, double z_min_m, double z_max_m);
 
 class CuboidRoi {
  public:
@@ -38,8 +37,8 @@ class CuboidRoi {
     const double rx = r_(0, 0) * dx + r_(1, 0) * dy + r_(2, 0) * dz;
     const double ry = r_(0, 1) * dx + r_(1, 1) * dy + r_(2, 1) * dz;
     const double rz = r_(0, 2) * dx + r_(1, 2) * dy + r_(2, 2) * dz;
-    return rx >= e_.x_min_m && rx <= e_.x_max_m && ry >= e_.y_min_m && ry <= e_.y_max_m &&
-           rz >= e_.z_min_m && rz <= e_.z_max_m;
+    return rx >= e_.x_min_m && rx <= e_.x_max_m && ry >= e_.y_min_m && ry <= e_.y_max_m && rz >= e_.z_min_m &&
+           rz <= e_.z_max_m;
   }
   [[nodiscard]] const CuboidExtent& extent() const noexcept { return e_; }
   [[nodiscard]] const Eigen::Isometry3d& global_from_robot() const noexcept { return pose_; }
@@ -54,8 +53,7 @@ class CuboidRoi {
 // Keeps the points (global frame) inside the cuboid; NaN/infinite points are counted and
 // never kept. `kept` is cleared and gets ascending indices.
 template <typename Point>
-FilterStats cuboid_filter(const CuboidRoi& cuboid, std::span<const Point> points,
-                          IndexVector& kept) {
+FilterStats cuboid_filter(const CuboidRoi& cuboid, std::span<const Point> points, IndexVector& kept) {
   struct NoZLimit {
     [[nodiscard]] bool contains(double) const noexcept { return true; }
   };
@@ -63,9 +61,9 @@ FilterStats cuboid_filter(const CuboidRoi& cuboid, std::span<const Point> points
   stats.input = points.size();
   kept.clear();
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const double x = points[i].x;
-    const double y = points[i].y;
-    const double z = points[i].z;
+    const auto x = static_cast<double>(points[i].x);
+    const auto y = static_cast<double>(points[i].y);
+    const auto z = static_cast<double>(points[i].z);
     const Precheck pre = precheck(NoZLimit{}, x, y, z);
     if (pre != Precheck::kPass) {
       count_rejection(stats, pre);

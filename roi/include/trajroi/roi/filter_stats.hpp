@@ -48,8 +48,7 @@ struct FilterStats {
 enum class Precheck : unsigned char { kPass, kNonFinite, kOutsideZ };
 
 template <typename ZLimitsT>
-[[nodiscard]] inline Precheck precheck(const ZLimitsT& z_limits, double x, double y,
-                                       double z) noexcept {
+[[nodiscard]] inline Precheck precheck(const ZLimitsT& z_limits, double x, double y, double z) noexcept {
   if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) return Precheck::kNonFinite;
   if (!z_limits.contains(z)) return Precheck::kOutsideZ;
   return Precheck::kPass;

@@ -75,13 +75,10 @@ class GridFilter {
   // widest the CPU supports; the others exist so tests can check each one (a path the CPU
   // lacks falls back to the next narrower one).
   template <typename Point>
-  FilterStats filter(std::span<const Point> points, IndexVector& kept,
-                     SimdPath path = SimdPath::kAuto) const;
+  FilterStats filter(std::span<const Point> points, IndexVector& kept, SimdPath path = SimdPath::kAuto) const;
 
   [[nodiscard]] std::size_t cell_count() const noexcept { return nx_ * ny_; }
-  [[nodiscard]] std::size_t boundary_cell_count() const noexcept {
-    return offsets_.empty() ? 0 : offsets_.size() - 1;
-  }
+  [[nodiscard]] std::size_t boundary_cell_count() const noexcept { return offsets_.empty() ? 0 : offsets_.size() - 1; }
   [[nodiscard]] double cell_size_m() const noexcept { return cell_size_m_; }
 
  private:
@@ -92,26 +89,25 @@ class GridFilter {
   static_assert(kOutside == 0 && kInside == 1);
 
   struct Scan {
-    std::uint32_t* out;   // room for every point
-    std::size_t count;    // indices written so far
+    std::uint32_t* out;  // room for every point
+    std::size_t count;   // indices written so far
     FilterStats* stats;
   };
   template <typename Point>
   void scalar_point(std::span<const Point> points, std::size_t i, Scan& scan) const;
 #if defined(__x86_64__) || defined(__i386__)
   std::size_t scan_sse2(std::span<const PointXYZI> points, Scan& scan) const;
-  __attribute__((target("avx2,popcnt"))) std::size_t scan_avx2(std::span<const PointXYZI> points,
-                                                               Scan& scan) const;
-  __attribute__((target("avx512f,popcnt"))) std::size_t scan_avx512(
-      std::span<const PointXYZI> points, Scan& scan) const;
+  __attribute__((target("avx2,popcnt"))) std::size_t scan_avx2(std::span<const PointXYZI> points, Scan& scan) const;
+  __attribute__((target("avx512f,popcnt"))) std::size_t scan_avx512(std::span<const PointXYZI> points,
+                                                                    Scan& scan) const;
   // For the vector scans. The points first … first + n − 1 one by one, `count` indices
   // written so far; returns the new count.
-  std::size_t scalar_block(std::span<const PointXYZI> points, std::size_t first, std::size_t n,
-                           Scan& scan, std::size_t count) const;
+  std::size_t scalar_block(std::span<const PointXYZI> points, std::size_t first, std::size_t n, Scan& scan,
+                           std::size_t count) const;
   // Bit k set for each lane k of `boundary` whose point first + k is kept, given the lanes'
   // cell values.
-  [[nodiscard]] unsigned decide_lanes(unsigned boundary, const std::uint32_t* value,
-                                      std::span<const PointXYZI> points, std::size_t first) const;
+  [[nodiscard]] unsigned decide_lanes(unsigned boundary, const std::uint32_t* value, std::span<const PointXYZI> points,
+                                      std::size_t first) const;
 #endif
 
   // 0/1: is the point (x, y) in a cell with this value kept? Tests candidates for boundary cells.
@@ -120,7 +116,7 @@ class GridFilter {
   [[nodiscard]] std::size_t cell_index(float x, float y) const noexcept;
 
   const RoiSet* rois_ = nullptr;
-  float x0_ = 0.0f;        // grid origin (global frame, m)
+  float x0_ = 0.0f;  // grid origin (global frame, m)
   float y0_ = 0.0f;
   float inv_cell_ = 1.0f;  // 1 / cell size (1/m)
   double cell_size_m_ = 1.0;
@@ -129,14 +125,14 @@ class GridFilter {
   std::vector<std::uint32_t> cells_;
   // Sub-cells per side of a boundary cell.
   static constexpr std::uint32_t kSub = 4;
-  std::vector<std::uint32_t> sub_;             // boundary id · kSub² + sub-cell → value
-  std::vector<std::uint32_t> sub_offsets_;     // sub-boundary id → [first, last) candidate
-  std::vector<std::uint32_t> sub_candidates_;  // ROI indices, nearest first
-  std::vector<std::uint32_t> offsets_;         // build scratch: boundary cell → candidates
-  std::vector<std::uint32_t> candidates_;      // build scratch
+  std::vector<std::uint32_t> sub_;                              // boundary id · kSub² + sub-cell → value
+  std::vector<std::uint32_t> sub_offsets_;                      // sub-boundary id → [first, last) candidate
+  std::vector<std::uint32_t> sub_candidates_;                   // ROI indices, nearest first
+  std::vector<std::uint32_t> offsets_;                          // build scratch: boundary cell → candidates
+  std::vector<std::uint32_t> candidates_;                       // build scratch
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;  // build scratch: (cell, roi)
-  std::vector<std::uint32_t> cursor_;                            // build scratch
-  std::vector<std::pair<double, double>> roi_centre_;            // build scratch
+  std::vector<std::uint32_t> cursor_;                           // build scratch
+  std::vector<std::pair<double, double>> roi_centre_;           // build scratch
 };
 
 extern template class GridFilter<CircularRoiSet>;

@@ -27,15 +27,14 @@ struct Confusion {
 
 // `kept`: ascending indices of the kept points; `truth[i]` non-zero when point i belongs to
 // the ground-truth ROI. Throws std::out_of_range for an index past truth.size().
-[[nodiscard]] Confusion confusion(std::span<const std::uint32_t> kept,
-                                  std::span<const std::uint8_t> truth);
+[[nodiscard]] Confusion confusion(std::span<const std::uint32_t> kept, std::span<const std::uint8_t> truth);
 
 // Copies the kept points, in order, into `out` (cleared first; capacity reused).
 template <typename Point>
-void compact(std::span<const Point> points, std::span<const std::uint32_t> kept,
-             std::vector<Point>& out) {
+void compact(std::span<const Point> points, std::span<const std::uint32_t> kept, std::vector<Point>& out) {
   out.clear();
-  for (const std::uint32_t i : kept) out.push_back(points[i]);
+  for (const std::uint32_t i : kept)
+    out.push_back(points[i]);
 }
 
 }  // namespace trajroi::roi

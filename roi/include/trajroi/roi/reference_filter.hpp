@@ -14,16 +14,15 @@ namespace trajroi::roi {
 // RoiSet is one of CircularRoiSet, RectangularRoiSet, CorridorRoiSet. `kept` is cleared and
 // receives the indices of the kept points in ascending order; its capacity is reused.
 template <typename RoiSet, typename Point>
-FilterStats reference_filter(const RoiSet& rois, std::span<const Point> points,
-                             IndexVector& kept) {
+FilterStats reference_filter(const RoiSet& rois, std::span<const Point> points, IndexVector& kept) {
   FilterStats stats;
   stats.input = points.size();
   kept.clear();
   const std::size_t m = rois.size();
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const double x = points[i].x;
-    const double y = points[i].y;
-    const Precheck pre = precheck(rois.z_limits(), x, y, points[i].z);
+    const auto x = static_cast<double>(points[i].x);
+    const auto y = static_cast<double>(points[i].y);
+    const Precheck pre = precheck(rois.z_limits(), x, y, static_cast<double>(points[i].z));
     if (pre != Precheck::kPass) {
       count_rejection(stats, pre);
       continue;

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <limits>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -39,16 +39,15 @@ struct ZLimits {
 // How one ROI relates to a whole cell of the fast filter's grid, decided with a margin so
 // that rounding in the per-point test can never contradict it.
 enum class CellRelation : unsigned char {
-  kOutside,  // no point of the cell can pass this ROI's test
-  kInside,   // every point of the cell passes this ROI's test
-  kBoundary, // undecided: points in the cell must be tested against this ROI
+  kOutside,   // no point of the cell can pass this ROI's test
+  kInside,    // every point of the cell passes this ROI's test
+  kBoundary,  // undecided: points in the cell must be tested against this ROI
 };
 
 // ----------------------------------------------------------------------------------------
 // Equation (1): p is in the circle around c when ‖p − c‖_XY ≤ r. Both the reference double
 // loop and the fast filter call exactly this, so they round identically.
-[[nodiscard]] inline bool circle_contains(double cx, double cy, double radius_m, double px,
-                                          double py) noexcept {
+[[nodiscard]] inline bool circle_contains(double cx, double cy, double radius_m, double px, double py) noexcept {
   const double dx = px - cx;
   const double dy = py - cy;
   return std::sqrt(dx * dx + dy * dy) <= radius_m;
@@ -73,8 +72,7 @@ class CircularRoiSet {
   [[nodiscard]] Box bounds(std::size_t j) const noexcept {
     return {cx_[j] - radius_m_, cy_[j] - radius_m_, cx_[j] + radius_m_, cy_[j] + radius_m_};
   }
-  [[nodiscard]] CellRelation relation(std::size_t j, const Box& cell,
-                                      double tolerance_m) const noexcept;
+  [[nodiscard]] CellRelation relation(std::size_t j, const Box& cell, double tolerance_m) const noexcept;
   // The grid cell size that keeps the boundary band thin without too many cells.
   [[nodiscard]] double cell_size_hint_m() const noexcept { return radius_m_ / 8.0; }
 
@@ -100,8 +98,8 @@ struct RectGeometry {
   double bc;        // ‖BC‖
 };
 
-[[nodiscard]] RectGeometry make_rect_geometry(double cx, double cy, double theta_rad,
-                                              double height_m, double width_m) noexcept;
+[[nodiscard]] RectGeometry make_rect_geometry(double cx, double cy, double theta_rad, double height_m,
+                                              double width_m) noexcept;
 
 // Equation (2): 0 ≤ AB·AP ≤ ‖AB‖² and 0 ≤ BC·BP ≤ ‖BC‖².
 [[nodiscard]] inline bool rect_contains(const RectGeometry& g, double px, double py) noexcept {
@@ -115,8 +113,7 @@ struct RectGeometry {
 // Throws std::invalid_argument when a or b is not finite and positive.
 class RectangularRoiSet {
  public:
-  RectangularRoiSet(double height_m, double width_m, std::span<const Centre> centres,
-                    ZLimits z = {});
+  RectangularRoiSet(double height_m, double width_m, std::span<const Centre> centres, ZLimits z = {});
   void assign(std::span<const Centre> centres);
   void assign(std::span<const Centre> centres, double height_m, double width_m);
 
@@ -129,11 +126,8 @@ class RectangularRoiSet {
     return rect_contains(rects_[j], px, py);
   }
   [[nodiscard]] Box bounds(std::size_t j) const noexcept;
-  [[nodiscard]] CellRelation relation(std::size_t j, const Box& cell,
-                                      double tolerance_m) const noexcept;
-  [[nodiscard]] double cell_size_hint_m() const noexcept {
-    return std::min(height_m_, width_m_) / 8.0;
-  }
+  [[nodiscard]] CellRelation relation(std::size_t j, const Box& cell, double tolerance_m) const noexcept;
+  [[nodiscard]] double cell_size_hint_m() const noexcept { return std::min(height_m_, width_m_) / 8.0; }
 
  private:
   double height_m_;
@@ -146,9 +140,8 @@ class RectangularRoiSet {
 // The exact corridor: points within w/2 of the trajectory between arc lengths s0 and s1,
 // i.e. the union of one capsule per polyline piece. It is the ground-truth labeller of the
 // evaluations, and a filter in its own right.
-[[nodiscard]] inline bool capsule_contains(double ax, double ay, double dx, double dy,
-                                           double length2, double half_width_m, double px,
-                                           double py) noexcept {
+[[nodiscard]] inline bool capsule_contains(double ax, double ay, double dx, double dy, double length2,
+                                           double half_width_m, double px, double py) noexcept {
   const double apx = px - ax;
   const double apy = py - ay;
   double t = length2 > 0.0 ? (apx * dx + apy * dy) / length2 : 0.0;
@@ -162,8 +155,7 @@ class CorridorRoiSet {
  public:
   // Throws std::invalid_argument when the width is not finite and positive; s0 and s1 are
   // clamped to the trajectory and may be equal (a disc around one point).
-  CorridorRoiSet(const Trajectory& trajectory, double s0_m, double s1_m, double width_m,
-                 ZLimits z = {});
+  CorridorRoiSet(const Trajectory& trajectory, double s0_m, double s1_m, double width_m, ZLimits z = {});
   void assign(const Trajectory& trajectory, double s0_m, double s1_m);
 
   [[nodiscard]] std::size_t size() const noexcept { return ax_.size(); }
@@ -173,8 +165,7 @@ class CorridorRoiSet {
     return capsule_contains(ax_[j], ay_[j], dx_[j], dy_[j], length2_[j], half_width_m_, px, py);
   }
   [[nodiscard]] Box bounds(std::size_t j) const noexcept;
-  [[nodiscard]] CellRelation relation(std::size_t j, const Box& cell,
-                                      double tolerance_m) const noexcept;
+  [[nodiscard]] CellRelation relation(std::size_t j, const Box& cell, double tolerance_m) const noexcept;
   [[nodiscard]] double cell_size_hint_m() const noexcept { return half_width_m_ / 4.0; }
 
  private:
@@ -211,15 +202,13 @@ inline SlabRange slab_range(double ox, double oy, double ex, double ey, const Bo
   const double mx = 0.5 * (cell.x_min + cell.x_max);
   const double my = 0.5 * (cell.y_min + cell.y_max);
   const double centre = ex * (mx - ox) + ey * (my - oy);
-  const double reach = std::abs(ex) * 0.5 * (cell.x_max - cell.x_min) +
-                       std::abs(ey) * 0.5 * (cell.y_max - cell.y_min);
+  const double reach = std::abs(ex) * 0.5 * (cell.x_max - cell.x_min) + std::abs(ey) * 0.5 * (cell.y_max - cell.y_min);
   return {centre - reach, centre + reach};
 }
 
 }  // namespace detail
 
-inline CellRelation CircularRoiSet::relation(std::size_t j, const Box& cell,
-                                      double tolerance_m) const noexcept {
+inline CellRelation CircularRoiSet::relation(std::size_t j, const Box& cell, double tolerance_m) const noexcept {
   if (std::sqrt(detail::box_far_distance2(cell, cx_[j], cy_[j])) <= radius_m_ - tolerance_m) {
     return CellRelation::kInside;
   }
@@ -229,8 +218,7 @@ inline CellRelation CircularRoiSet::relation(std::size_t j, const Box& cell,
   return CellRelation::kBoundary;
 }
 
-inline CellRelation RectangularRoiSet::relation(std::size_t j, const Box& cell,
-                                         double tolerance_m) const noexcept {
+inline CellRelation RectangularRoiSet::relation(std::size_t j, const Box& cell, double tolerance_m) const noexcept {
   const RectGeometry& g = rects_[j];
   // f1 = AB·(p − A) ∈ [0, ‖AB‖²] and f2 = BC·(p − B) ∈ [0, ‖BC‖²]; f / ‖e‖ is a distance, so
   // a margin of tolerance_m metres is tolerance_m · ‖e‖ in f units.

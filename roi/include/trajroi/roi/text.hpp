@@ -36,8 +36,7 @@ void for_each_line(std::string_view text, F&& f) {
 // Parses comma-separated numbers (spaces around each allowed) into `out`. Returns the number
 // of fields, or 0 when a field is not a number in full ("1.5x", "", "--1") or there are more
 // fields than `out` holds. "nan" and "inf" parse; callers decide what to do with them.
-[[nodiscard]] inline std::size_t parse_csv_doubles(std::string_view content,
-                                                   std::span<double> out) noexcept {
+[[nodiscard]] inline std::size_t parse_csv_doubles(std::string_view content, std::span<double> out) noexcept {
   std::size_t count = 0;
   std::size_t start = 0;
   while (true) {

@@ -10,10 +10,10 @@
 namespace trajroi::roi {
 
 enum class TrajectoryErrc {
-  kTooFewPoints,      // fewer than two distinct waypoints (after removing consecutive duplicates)
-  kNonFinitePoint,    // a waypoint coordinate is NaN or infinite
-  kTooManyPoints,     // more waypoints than kMaxWaypoints
-  kParse,             // text that is not a waypoint line
+  kTooFewPoints,    // fewer than two distinct waypoints (after removing consecutive duplicates)
+  kNonFinitePoint,  // a waypoint coordinate is NaN or infinite
+  kTooManyPoints,   // more waypoints than kMaxWaypoints
+  kParse,           // text that is not a waypoint line
 };
 
 [[nodiscard]] std::string_view to_string(TrajectoryErrc code) noexcept;
@@ -22,8 +22,7 @@ enum class TrajectoryErrc {
 // trajectory arrives (a rare event): callers that must not stop catch it and count code().
 class TrajectoryError : public std::invalid_argument {
  public:
-  TrajectoryError(TrajectoryErrc code, const std::string& message)
-      : std::invalid_argument(message), code_(code) {}
+  TrajectoryError(TrajectoryErrc code, const std::string& message) : std::invalid_argument(message), code_(code) {}
   [[nodiscard]] TrajectoryErrc code() const noexcept { return code_; }
 
  private:
@@ -32,9 +31,9 @@ class TrajectoryError : public std::invalid_argument {
 
 // Closest point of a trajectory to a query position.
 struct Projection {
-  double s_m;               // arc length of the closest point
-  double distance_m;        // distance from the query to it
-  Eigen::Vector2d point;    // the closest point itself (global frame)
+  double s_m;             // arc length of the closest point
+  double distance_m;      // distance from the query to it
+  Eigen::Vector2d point;  // the closest point itself (global frame)
 };
 
 // The robot's target path: a polyline of global-frame XY waypoints (metres), parametrised by
@@ -71,8 +70,7 @@ class Trajectory {
                                    double max_advance_m) const noexcept;
 
  private:
-  [[nodiscard]] Projection project_range(const Eigen::Vector2d& position, double s_lo,
-                                         double s_hi) const noexcept;
+  [[nodiscard]] Projection project_range(const Eigen::Vector2d& position, double s_lo, double s_hi) const noexcept;
 
   std::vector<Eigen::Vector2d> points_;
   std::vector<Eigen::Vector2d> direction_;  // unit vector of each segment

@@ -12,8 +12,7 @@ namespace trajroi::roi {
 
 // A planar pose as a 3-D isometry: translation (x_m, y_m, z_m), rotation yaw_rad about +z
 // (counter-clockwise from +x, REP-103).
-[[nodiscard]] Eigen::Isometry3d pose_from_xy_yaw(double x_m, double y_m, double yaw_rad,
-                                                 double z_m = 0.0);
+[[nodiscard]] Eigen::Isometry3d pose_from_xy_yaw(double x_m, double y_m, double yaw_rad, double z_m = 0.0);
 
 // A sensor's mounting, a_from_b = T(xyz) · Rz(yaw) · Ry(pitch) · Rx(roll) (angles in rad).
 [[nodiscard]] Eigen::Isometry3d pose_from_xyz_rpy(const Eigen::Vector3d& xyz_m, double roll_rad, double pitch_rad,

@@ -10,7 +10,6 @@
 #pragma once
 
 #include <lcm/lcm-cpp.hpp>
-
 #include <string>
 
 namespace trajroi::transport {

@@ -37,7 +37,8 @@ class SpscRing {
   explicit SpscRing(std::size_t capacity) : SpscRing(capacity, [] { return T{}; }) {}
   template <typename Make>
   SpscRing(std::size_t capacity, Make make) : mask_(round_up(capacity) - 1), slots_(new Slot[mask_ + 1]) {
-    for (std::size_t i = 0; i <= mask_; ++i) slots_[i].item = make();
+    for (std::size_t i = 0; i <= mask_; ++i)
+      slots_[i].item = make();
   }
 
   SpscRing(const SpscRing&) = delete;
@@ -114,7 +115,8 @@ class SpscRing {
   static std::size_t round_up(std::size_t n) {
     if (n > (std::size_t{1} << 30)) throw std::invalid_argument("SpscRing: capacity above 2^30");
     std::size_t c = 2;
-    while (c < n) c <<= 1;
+    while (c < n)
+      c <<= 1;
     return c;
   }
   struct alignas(kCacheLine) Slot {

@@ -40,7 +40,7 @@ class MapReader {
 
   [[nodiscard]] bool has(std::string_view key) const;
 
-  [[nodiscard]] double number(std::string_view key);                 // required
+  [[nodiscard]] double number(std::string_view key);  // required
   [[nodiscard]] double number(std::string_view key, double fallback);
   // A number that must be > 0 / ≥ 0 (checked, "must be > 0" / "must be >= 0").
   [[nodiscard]] double positive(std::string_view key, double fallback);

@@ -26,11 +26,11 @@ namespace trajroi::framing {
 // What a protocol makes of the bytes at a sync candidate.
 struct Verdict {
   enum class Kind : std::uint8_t {
-    kNeedMore,    // cannot decide before `length` bytes are available
-    kNotSync,     // the first byte was a sync byte, the rest does not look like a header
-    kBadLength,   // the header claims a length beyond the configured maximum
-    kUnsizable,   // the header describes a frame whose size cannot be computed
-    kFrame,       // a complete frame of `length` bytes, still to be checksummed
+    kNeedMore,   // cannot decide before `length` bytes are available
+    kNotSync,    // the first byte was a sync byte, the rest does not look like a header
+    kBadLength,  // the header claims a length beyond the configured maximum
+    kUnsizable,  // the header describes a frame whose size cannot be computed
+    kFrame,      // a complete frame of `length` bytes, still to be checksummed
   };
   Kind kind = Kind::kNeedMore;
   std::size_t length = 0;
@@ -115,9 +115,14 @@ class StreamFramer {
           if (!at_end) return at;  // keep the candidate for the next chunk
           ++counters_.truncated;
           break;
-        case Kind::kNotSync: break;
-        case Kind::kBadLength: ++counters_.bad_lengths; break;
-        case Kind::kUnsizable: ++counters_.unsizable; break;
+        case Kind::kNotSync:
+          break;
+        case Kind::kBadLength:
+          ++counters_.bad_lengths;
+          break;
+        case Kind::kUnsizable:
+          ++counters_.unsizable;
+          break;
         case Kind::kFrame:
           if (verdict.length > candidate.size()) {
             if (!at_end) return at;

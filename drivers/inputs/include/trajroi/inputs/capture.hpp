@@ -12,8 +12,8 @@ namespace trajroi::inputs {
 
 class CaptureDecoder {
  public:
-  CaptureDecoder(vlp16::PacketSource& source, vlp16::StreamDecoder& decoder,
-                 std::uint16_t data_port = vlp16::kDataPort, std::uint16_t position_port = vlp16::kPositionPort)
+  CaptureDecoder(vlp16::PacketSource& source, vlp16::StreamDecoder& decoder, std::uint16_t data_port = vlp16::kDataPort,
+                 std::uint16_t position_port = vlp16::kPositionPort)
       : source_(source), decoder_(decoder), data_port_(data_port), position_port_(position_port) {}
 
   // Decodes the next datagram (frames finished by it go to `sink`). kDatagram: one was

@@ -21,7 +21,9 @@ enum class Stream : std::uint8_t {
 };
 inline constexpr std::size_t kStreamCount = 4;
 [[nodiscard]] std::string_view to_string(Stream stream) noexcept;
-[[nodiscard]] constexpr bool is_lidar(Stream s) noexcept { return s == Stream::kLidarData || s == Stream::kLidarPosition; }
+[[nodiscard]] constexpr bool is_lidar(Stream s) noexcept {
+  return s == Stream::kLidarData || s == Stream::kLidarPosition;
+}
 
 struct InputItem {
   Stream stream = Stream::kLidarData;

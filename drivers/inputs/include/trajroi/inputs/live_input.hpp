@@ -51,8 +51,8 @@ class SerialInput final : public InputSource {
   Stream stream_;
   std::unique_ptr<serial::SerialPortSource> port_;
   std::uint64_t opens_ = 0, items_ = 0;
-  serial::Chunk pending_;       // the last read; its bytes live in the port until the next read
-  bool have_pending_ = false;   // read with the port's opening, handed out after the notice
+  serial::Chunk pending_;      // the last read; its bytes live in the port until the next read
+  bool have_pending_ = false;  // read with the port's opening, handed out after the notice
   Notice notice_;
 };
 

@@ -57,7 +57,7 @@ struct PoseInputCounters {
   std::uint64_t malformed = 0;         // framed UBX/VN-100 that did not decode
   std::uint64_t attitudes = 0;
   std::uint64_t imu_without_attitude = 0;  // frames lacking TimeStartup or YawPitchRoll
-  std::uint64_t refused = 0;           // samples the buffer refused (order, non-finite)
+  std::uint64_t refused = 0;               // samples the buffer refused (order, non-finite)
 };
 
 class PoseInput {

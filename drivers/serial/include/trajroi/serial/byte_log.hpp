@@ -44,18 +44,16 @@ class RecordingWriter {
 };
 
 enum class RawTiming : std::uint8_t {
-  kNominalRate,     // chunk_bytes per chunk at bytes_per_second
-  kUbxTime,         // one chunk per UBX frame, spaced by NAV iTOW (nominal rate before the first)
-  kVn100Time,       // one chunk per VN-100 frame, spaced by TimeStartup (nominal rate without)
+  kNominalRate,  // chunk_bytes per chunk at bytes_per_second
+  kUbxTime,      // one chunk per UBX frame, spaced by NAV iTOW (nominal rate before the first)
+  kVn100Time,    // one chunk per VN-100 frame, spaced by TimeStartup (nominal rate without)
 };
 
 struct ReplayOptions {
-  // 0: as fast as possible; 1: real time; N: N× real time.
-  double speed = 0.0;
   RawTiming raw_timing = RawTiming::kNominalRate;
   double bytes_per_second = 11'520.0;  // 115200 baud, 8N1
   std::size_t chunk_bytes = 64;
-  std::int64_t start_time_ns = 0;      // host time given to the first byte of a raw file
+  std::int64_t start_time_ns = 0;  // host time given to the first byte of a raw file
 };
 
 // Replays a recording (detected by its magic) or a raw byte file. Throws std::runtime_error
@@ -87,7 +85,6 @@ class ReplaySource final : public ByteSource {
   std::size_t next_ = 0;
   bool recording_ = false;
   std::uint64_t truncated_records_ = 0;
-  std::int64_t wall_start_ns_ = 0;
   SourceCounters counters_;
 };
 

@@ -26,9 +26,9 @@ enum class ReadStatus : std::uint8_t {
 struct SourceCounters {
   std::uint64_t chunks = 0;
   std::uint64_t bytes = 0;
-  std::uint64_t disconnects = 0;     // a port that was open and failed
-  std::uint64_t open_failures = 0;   // attempts to (re)open that failed
-  std::uint64_t opens = 0;           // successful opens
+  std::uint64_t disconnects = 0;    // a port that was open and failed
+  std::uint64_t open_failures = 0;  // attempts to (re)open that failed
+  std::uint64_t opens = 0;          // successful opens
 };
 
 class ByteSource {

@@ -50,7 +50,8 @@ inline constexpr std::uint8_t kLayerFlash = 0x04;
 // `rate_hz` (F9: one CFG-VALSET; M8: a CFG-RATE, then a CFG-MSG per message). Each one is
 // answered by an ACK. Throws for a rate outside 0.1 … 50 Hz.
 enum class Generation : std::uint8_t { kM8, kF9 };
-[[nodiscard]] std::vector<std::vector<std::uint8_t>> pose_output_configuration(
-    Generation generation, Port port, double rate_hz, std::span<const PoseMessage> messages);
+[[nodiscard]] std::vector<std::vector<std::uint8_t>> pose_output_configuration(Generation generation, Port port,
+                                                                               double rate_hz,
+                                                                               std::span<const PoseMessage> messages);
 
 }  // namespace trajroi::ublox

@@ -16,7 +16,7 @@ namespace trajroi::ublox {
 
 inline constexpr std::uint8_t kSync1 = 0xB5;
 inline constexpr std::uint8_t kSync2 = 0x62;
-inline constexpr std::size_t kHeaderBytes = 6;    // sync ×2, class, id, length ×2
+inline constexpr std::size_t kHeaderBytes = 6;  // sync ×2, class, id, length ×2
 inline constexpr std::size_t kChecksumBytes = 2;
 inline constexpr std::size_t kOverheadBytes = kHeaderBytes + kChecksumBytes;
 // Large enough for RXM-RAWX with 128 measurements (16 + 32 × 128 bytes); longer claims are
@@ -31,9 +31,7 @@ struct Message {
   std::uint8_t msg_class = 0;
   std::uint8_t msg_id = 0;
   std::span<const std::uint8_t> payload;
-  [[nodiscard]] std::uint16_t key() const noexcept {
-    return static_cast<std::uint16_t>((msg_class << 8) | msg_id);
-  }
+  [[nodiscard]] std::uint16_t key() const noexcept { return static_cast<std::uint16_t>((msg_class << 8) | msg_id); }
 };
 
 // "NAV-PVT", "ACK-ACK", …; unknown ids are written "NAV-0x3D", unknown classes "0xF5-0x05".

@@ -62,20 +62,20 @@ struct NavPvt {
   std::uint32_t time_accuracy_ns = 0;
   std::int32_t nano_ns = 0;  // signed fraction to add to the second, −1e9 … 1e9
   std::uint8_t fix_type_raw = 0;
-  bool gnss_fix_ok = false;   // fix within the receiver's accuracy masks
-  bool diff_soln = false;     // differential corrections applied
+  bool gnss_fix_ok = false;  // fix within the receiver's accuracy masks
+  bool diff_soln = false;    // differential corrections applied
   CarrierSolution carr_soln = CarrierSolution::kNone;
   bool head_veh_valid = false;
   std::uint8_t num_sv = 0;
-  std::int32_t lon_e7 = 0, lat_e7 = 0;       // 1e-7 degree
-  std::int32_t height_mm = 0, hmsl_mm = 0;   // above the ellipsoid / mean sea level
+  std::int32_t lon_e7 = 0, lat_e7 = 0;      // 1e-7 degree
+  std::int32_t height_mm = 0, hmsl_mm = 0;  // above the ellipsoid / mean sea level
   std::uint32_t h_acc_mm = 0, v_acc_mm = 0;
   std::int32_t vel_n_mmps = 0, vel_e_mmps = 0, vel_d_mmps = 0, ground_speed_mmps = 0;
-  std::int32_t head_mot_e5deg = 0;           // heading of motion, clockwise from north
+  std::int32_t head_mot_e5deg = 0;  // heading of motion, clockwise from north
   std::uint32_t speed_acc_mmps = 0, head_acc_e5deg = 0;
   std::uint16_t pdop_e2 = 0;
-  bool invalid_llh = false;                  // flags3 bit 0 (newer firmware)
-  bool has_head_veh = false;                 // 92-byte form only
+  bool invalid_llh = false;   // flags3 bit 0 (newer firmware)
+  bool has_head_veh = false;  // 92-byte form only
   std::int32_t head_veh_e5deg = 0;
 
   bool operator==(const NavPvt&) const = default;
@@ -103,16 +103,24 @@ struct NavHpposllh {
   bool invalid_llh = false;
   std::uint32_t itow_ms = 0;
   std::int32_t lon_e7 = 0, lat_e7 = 0, height_mm = 0, hmsl_mm = 0;
-  std::int8_t lon_hp_e9 = 0, lat_hp_e9 = 0;          // 1e-9 degree, −99 … 99
-  std::int8_t height_hp_e4m = 0, hmsl_hp_e4m = 0;    // 0.1 mm, −9 … 9
-  std::uint32_t h_acc_e4m = 0, v_acc_e4m = 0;        // 0.1 mm
+  std::int8_t lon_hp_e9 = 0, lat_hp_e9 = 0;        // 1e-9 degree, −99 … 99
+  std::int8_t height_hp_e4m = 0, hmsl_hp_e4m = 0;  // 0.1 mm, −9 … 9
+  std::uint32_t h_acc_e4m = 0, v_acc_e4m = 0;      // 0.1 mm
   bool operator==(const NavHpposllh&) const = default;
 
   // Combined in integers first, so the only rounding is the final scaling.
-  [[nodiscard]] double lat_deg() const noexcept { return static_cast<double>(std::int64_t{lat_e7} * 100 + lat_hp_e9) * 1e-9; }
-  [[nodiscard]] double lon_deg() const noexcept { return static_cast<double>(std::int64_t{lon_e7} * 100 + lon_hp_e9) * 1e-9; }
-  [[nodiscard]] double height_m() const noexcept { return static_cast<double>(std::int64_t{height_mm} * 10 + height_hp_e4m) * 1e-4; }
-  [[nodiscard]] double hmsl_m() const noexcept { return static_cast<double>(std::int64_t{hmsl_mm} * 10 + hmsl_hp_e4m) * 1e-4; }
+  [[nodiscard]] double lat_deg() const noexcept {
+    return static_cast<double>(std::int64_t{lat_e7} * 100 + lat_hp_e9) * 1e-9;
+  }
+  [[nodiscard]] double lon_deg() const noexcept {
+    return static_cast<double>(std::int64_t{lon_e7} * 100 + lon_hp_e9) * 1e-9;
+  }
+  [[nodiscard]] double height_m() const noexcept {
+    return static_cast<double>(std::int64_t{height_mm} * 10 + height_hp_e4m) * 1e-4;
+  }
+  [[nodiscard]] double hmsl_m() const noexcept {
+    return static_cast<double>(std::int64_t{hmsl_mm} * 10 + hmsl_hp_e4m) * 1e-4;
+  }
   [[nodiscard]] double h_acc_m() const noexcept { return h_acc_e4m * 1e-4; }
   [[nodiscard]] double v_acc_m() const noexcept { return v_acc_e4m * 1e-4; }
 };
@@ -125,19 +133,25 @@ struct NavRelposned {
   std::uint32_t itow_ms = 0;
   std::int32_t rel_pos_n_cm = 0, rel_pos_e_cm = 0, rel_pos_d_cm = 0;
   std::int8_t rel_pos_hp_n_e4m = 0, rel_pos_hp_e_e4m = 0, rel_pos_hp_d_e4m = 0;
-  std::int32_t rel_pos_length_cm = 0;       // version 1
-  std::int8_t rel_pos_hp_length_e4m = 0;    // version 1
-  std::int32_t rel_pos_heading_e5deg = 0;   // version 1: clockwise from north
+  std::int32_t rel_pos_length_cm = 0;      // version 1
+  std::int8_t rel_pos_hp_length_e4m = 0;   // version 1
+  std::int32_t rel_pos_heading_e5deg = 0;  // version 1: clockwise from north
   std::uint32_t acc_n_e4m = 0, acc_e_e4m = 0, acc_d_e4m = 0;
   std::uint32_t acc_length_e4m = 0, acc_heading_e5deg = 0;  // version 1
   bool gnss_fix_ok = false, diff_soln = false, rel_pos_valid = false;
   CarrierSolution carr_soln = CarrierSolution::kNone;
   bool is_moving = false, ref_pos_miss = false, ref_obs_miss = false;
-  bool heading_valid = false;               // version 1 only (relPosHeadingValid)
+  bool heading_valid = false;  // version 1 only (relPosHeadingValid)
 
-  [[nodiscard]] double rel_pos_n_m() const noexcept { return static_cast<double>(std::int64_t{rel_pos_n_cm} * 100 + rel_pos_hp_n_e4m) * 1e-4; }
-  [[nodiscard]] double rel_pos_e_m() const noexcept { return static_cast<double>(std::int64_t{rel_pos_e_cm} * 100 + rel_pos_hp_e_e4m) * 1e-4; }
-  [[nodiscard]] double rel_pos_d_m() const noexcept { return static_cast<double>(std::int64_t{rel_pos_d_cm} * 100 + rel_pos_hp_d_e4m) * 1e-4; }
+  [[nodiscard]] double rel_pos_n_m() const noexcept {
+    return static_cast<double>(std::int64_t{rel_pos_n_cm} * 100 + rel_pos_hp_n_e4m) * 1e-4;
+  }
+  [[nodiscard]] double rel_pos_e_m() const noexcept {
+    return static_cast<double>(std::int64_t{rel_pos_e_cm} * 100 + rel_pos_hp_e_e4m) * 1e-4;
+  }
+  [[nodiscard]] double rel_pos_d_m() const noexcept {
+    return static_cast<double>(std::int64_t{rel_pos_d_cm} * 100 + rel_pos_hp_d_e4m) * 1e-4;
+  }
   [[nodiscard]] double heading_deg() const noexcept { return rel_pos_heading_e5deg * 1e-5; }
   [[nodiscard]] double heading_acc_deg() const noexcept { return acc_heading_e5deg * 1e-5; }
 };

@@ -54,7 +54,7 @@ enum class ReturnType : std::uint8_t { kStrongest = 1, kLast = 2, kBoth = 3 };
 [[nodiscard]] std::string_view to_string(ReturnType type) noexcept;
 
 struct Point {
-  float x;                       // sensor frame, m
+  float x;  // sensor frame, m
   float y;
   float z;
   float distance_m;              // corrected range
@@ -77,9 +77,9 @@ class PacketDecoder {
   explicit PacketDecoder(const Calibration& calibration, DecodeOptions options = {});
 
   struct Result {
-    std::size_t points = 0;        // appended to `out`
-    std::size_t no_return = 0;     // zero distance
-    std::size_t out_of_range = 0;  // outside [min_range, max_range]
+    std::size_t points = 0;          // appended to `out`
+    std::size_t no_return = 0;       // zero distance
+    std::size_t out_of_range = 0;    // outside [min_range, max_range]
     std::size_t merged_returns = 0;  // dual mode: second returns identical to the first
     // points + no_return + out_of_range + merged_returns = 384 per packet
   };

@@ -14,17 +14,17 @@ namespace trajroi::vlp16 {
 
 inline constexpr std::size_t kDataPacketBytes = 1206;
 inline constexpr std::size_t kBlocks = 12;
-inline constexpr std::size_t kBlockBytes = 100;       // flag 2 + azimuth 2 + 32 × 3
+inline constexpr std::size_t kBlockBytes = 100;  // flag 2 + azimuth 2 + 32 × 3
 inline constexpr std::size_t kLasers = 16;
-inline constexpr std::size_t kFiringsPerBlock = 2;    // two firing sequences of 16 lasers
-inline constexpr std::size_t kTimestampOffset = 1200; // µs past the hour, uint32 LE
+inline constexpr std::size_t kFiringsPerBlock = 2;     // two firing sequences of 16 lasers
+inline constexpr std::size_t kTimestampOffset = 1200;  // µs past the hour, uint32 LE
 inline constexpr std::size_t kReturnModeOffset = 1204;
 inline constexpr std::size_t kProductIdOffset = 1205;
-inline constexpr std::uint16_t kBlockFlag = 0xEEFF;   // bytes FF EE, read little-endian
-inline constexpr std::uint16_t kAzimuthLimit = 36000; // hundredths of a degree
+inline constexpr std::uint16_t kBlockFlag = 0xEEFF;    // bytes FF EE, read little-endian
+inline constexpr std::uint16_t kAzimuthLimit = 36000;  // hundredths of a degree
 inline constexpr double kDistanceUnit_m = 0.002;
-inline constexpr double kLaserPeriod_us = 2.304;      // between two lasers of one firing
-inline constexpr double kFiringCycle_us = 55.296;     // one firing sequence, recharge included
+inline constexpr double kLaserPeriod_us = 2.304;                    // between two lasers of one firing
+inline constexpr double kFiringCycle_us = 55.296;                   // one firing sequence, recharge included
 inline constexpr double kBlockDuration_us = 2.0 * kFiringCycle_us;  // 110.592: a block's two sequences
 // The same in whole nanoseconds (exact: the manual's figures are multiples of 1 ns).
 inline constexpr std::int64_t kLaserPeriod_ns = 2'304;
@@ -83,7 +83,8 @@ inline constexpr auto& read_u32 = framing::le_u32;
 // Channel 0 … 31 of a block: its firing time after the block's first, as a fraction of the
 // block's duration — the weight of the azimuth advance that a channel's azimuth takes.
 [[nodiscard]] inline double azimuth_fraction(std::size_t channel) noexcept {
-  return (static_cast<double>(channel / kLasers) * kFiringCycle_us + static_cast<double>(channel % kLasers) * kLaserPeriod_us) /
+  return (static_cast<double>(channel / kLasers) * kFiringCycle_us +
+          static_cast<double>(channel % kLasers) * kLaserPeriod_us) /
          kBlockDuration_us;
 }
 

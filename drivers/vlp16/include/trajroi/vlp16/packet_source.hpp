@@ -16,7 +16,7 @@ inline constexpr std::uint16_t kPositionPort = 8308;
 struct Datagram {
   std::span<const std::uint8_t> payload;  // valid until the next call to next()
   std::uint16_t destination_port = 0;
-  std::int64_t receive_time_ns = 0;       // CLOCK_REALTIME: kernel receive stamp, or pcap record time
+  std::int64_t receive_time_ns = 0;  // CLOCK_REALTIME: kernel receive stamp, or pcap record time
 };
 
 class PacketSource {

@@ -17,8 +17,6 @@ namespace trajroi::vlp16 {
 struct PcapOptions {
   // UDP datagrams to these destination ports are delivered; others are skipped and counted.
   std::vector<std::uint16_t> ports{kDataPort, kPositionPort};
-  // Replay pacing: 0 as fast as possible, 1 in real time, N at N × real time.
-  double speed = 0.0;
 };
 
 // Link types understood: Ethernet (with or without 802.1Q / 802.1ad tags), Linux cooked
@@ -27,14 +25,14 @@ struct PcapOptions {
 class PcapSource final : public PacketSource {
  public:
   // Throws std::runtime_error naming the file when it cannot be opened or its link type is
-  // not one of the above, or when the speed is negative.
+  // not one of the above.
   explicit PcapSource(const std::filesystem::path& path, PcapOptions options = {});
   ~PcapSource() override;
   PcapSource(const PcapSource&) = delete;
   PcapSource& operator=(const PcapSource&) = delete;
 
   Next next(Datagram& datagram, std::chrono::milliseconds timeout) override;
-  // As fast as the options allow, no timeout.
+  // The next datagram (a capture is read as fast as asked: pacing is inputs::Pacer's).
   Next next(Datagram& datagram) { return next(datagram, std::chrono::milliseconds::max()); }
 
   [[nodiscard]] const std::string& error() const noexcept override { return error_; }
@@ -50,12 +48,6 @@ class PcapSource final : public PacketSource {
   int link_type_ = 0;
   std::uint64_t skipped_ = 0;
   std::string error_;
-  // Pacing: the first record's time and the steady-clock instant it was delivered.
-  bool paced_start_ = false;
-  std::int64_t first_record_ns_ = 0;
-  std::chrono::steady_clock::time_point first_delivery_;
-  bool pending_ = false;  // a datagram read but not yet due
-  Datagram pending_datagram_;
 };
 
 // Writes UDP payloads to a pcap file (nanosecond timestamps), wrapped in Ethernet + IPv4 +

@@ -35,10 +35,10 @@ inline constexpr std::size_t kNmeaErrorCount = 5;
 
 // The recommended minimum fix: time, validity and position.
 struct Rmc {
-  std::int64_t utc_ns = 0;  // since 1970-01-01 UTC
-  bool valid = false;       // status 'A'
-  double latitude_deg = 0;  // north positive
-  double longitude_deg = 0; // east positive
+  std::int64_t utc_ns = 0;   // since 1970-01-01 UTC
+  bool valid = false;        // status 'A'
+  double latitude_deg = 0;   // north positive
+  double longitude_deg = 0;  // east positive
 };
 
 // Parses one NMEA RMC sentence (any talker: GP, GN, …), checksum verified. Date years 80–99
@@ -49,7 +49,7 @@ struct PositionPacket {
   std::uint32_t toh_us = 0;  // the packet's own top-of-hour timestamp
   PpsStatus pps = PpsStatus::kAbsent;
   NmeaError nmea = NmeaError::kEmpty;
-  Rmc rmc;                   // meaningful when nmea == kNone
+  Rmc rmc;  // meaningful when nmea == kNone
 };
 
 // False (and `out` untouched) unless the payload is exactly 512 bytes.

@@ -47,17 +47,17 @@ struct StreamOptions {
 };
 
 struct Frame {
-  std::uint64_t index = 0;                  // 0, 1, … in the order frames complete
-  std::int64_t start_time_ns = 0;           // first point, receive clock
-  std::int64_t end_time_ns = 0;             // last point, receive clock
-  std::optional<std::int64_t> start_utc_ns; // first point in UTC, when the clock is locked
-  std::uint32_t packets = 0;                // packets whose first firing is in this frame
-  std::uint32_t lost_packets = 0;           // detected inside this frame
+  std::uint64_t index = 0;                   // 0, 1, … in the order frames complete
+  std::int64_t start_time_ns = 0;            // first point, receive clock
+  std::int64_t end_time_ns = 0;              // last point, receive clock
+  std::optional<std::int64_t> start_utc_ns;  // first point in UTC, when the clock is locked
+  std::uint32_t packets = 0;                 // packets whose first firing is in this frame
+  std::uint32_t lost_packets = 0;            // detected inside this frame
   ReturnMode return_mode = ReturnMode::kStrongest;
   // Not a whole sweep: the first frame (the stream started mid-sweep), the last one at
   // flush(), and a frame cut by kMaxFrameDuration_ns.
   bool partial = false;
-  std::vector<Point> points;                // time_offset_ns after start_time_ns
+  std::vector<Point> points;  // time_offset_ns after start_time_ns
 };
 
 class FrameSink {
@@ -76,20 +76,20 @@ class FrameSink {
 };
 
 struct StreamCounters {
-  std::uint64_t data_packets = 0;      // handed to on_data_packet
+  std::uint64_t data_packets = 0;  // handed to on_data_packet
   std::uint64_t decoded_packets = 0;
   std::array<std::uint64_t, kPacketErrorCount> rejected{};  // by PacketError (kNone unused)
   std::uint64_t lost_packets = 0;
   std::uint64_t out_of_order = 0;
-  std::uint64_t late_dropped = 0;      // out of order and older than the current frame
+  std::uint64_t late_dropped = 0;  // out of order and older than the current frame
   std::uint64_t duplicates = 0;
   std::uint64_t clock_resets = 0;
-  std::uint64_t restarts = 0;          // sensor time jumped back by more than kRestartThreshold_us
+  std::uint64_t restarts = 0;  // sensor time jumped back by more than kRestartThreshold_us
   std::uint64_t points = 0;
   std::uint64_t no_return = 0;
   std::uint64_t out_of_range = 0;
   std::uint64_t merged_returns = 0;
-  std::uint64_t frames = 0;            // complete sweeps delivered
+  std::uint64_t frames = 0;  // complete sweeps delivered
   std::uint64_t partial_frames = 0;
   std::uint64_t position_packets = 0;  // handed to on_position_packet
   std::uint64_t position_wrong_size = 0;

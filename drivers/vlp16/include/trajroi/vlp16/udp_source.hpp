@@ -18,7 +18,7 @@ namespace trajroi::vlp16 {
 
 struct UdpOptions {
   std::string bind_address = "0.0.0.0";  // IPv4 address to bind both sockets to
-  std::uint16_t data_port = kDataPort;  // 0: the kernel chooses (tests)
+  std::uint16_t data_port = kDataPort;   // 0: the kernel chooses (tests)
   std::uint16_t position_port = kPositionPort;
   bool open_position_socket = true;
   int receive_buffer_bytes = 4 << 20;  // SO_RCVBUF asked for; see granted_receive_buffer_bytes()
@@ -84,7 +84,7 @@ class UdpSource final : public PacketSource {
   std::uint64_t truncated_ = 0;
   std::uint64_t rejected_sources_ = 0;
   std::uint32_t sensor_address_ = 0;  // network byte order; 0: any sender
-  std::size_t turn_ = 0;  // alternate between sockets so neither starves
+  std::size_t turn_ = 0;              // alternate between sockets so neither starves
   std::string error_;
 };
 

@@ -22,9 +22,9 @@ enum class Field : std::uint8_t {
   kTimeSyncIn,
   kYawPitchRoll,
   kQuaternion,
-  kAngularRate,       // compensated
-  kAccel,             // compensated
-  kMag,               // compensated
+  kAngularRate,  // compensated
+  kAccel,        // compensated
+  kMag,          // compensated
   kUncompMag,
   kUncompAccel,
   kUncompGyro,
@@ -51,7 +51,7 @@ struct Sample {
   void set(Field f) noexcept { present |= 1U << static_cast<unsigned>(f); }
 
   std::uint64_t time_startup_ns = 0;
-  std::uint64_t time_gps_ns = 0;     // since the GPS epoch (1980-01-06)
+  std::uint64_t time_gps_ns = 0;  // since the GPS epoch (1980-01-06)
   std::uint64_t time_sync_in_ns = 0;
   std::array<float, 3> ypr_deg{};
   std::array<float, 4> quaternion_xyzw{};
@@ -63,7 +63,7 @@ struct Sample {
   std::array<float, 3> uncomp_gyro_rps{};
   float temperature_c = 0;
   float pressure_kpa = 0;
-  std::array<float, 9> dcm{};        // row-major
+  std::array<float, 9> dcm{};  // row-major
   std::array<float, 3> mag_ned_gauss{};
   std::array<float, 3> accel_ned_mps2{};
   std::array<float, 3> linear_accel_body_mps2{};

@@ -10,10 +10,9 @@
 // at a point converts with global_yaw_from_true_bearing(), which includes the rotation of the
 // point's local north within the global frame (UTM meridian convergence; the small tilt of
 // north away from the origin for LocalCartesian).
-#include <memory>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <memory>
 
 namespace trajroi::pose {
 

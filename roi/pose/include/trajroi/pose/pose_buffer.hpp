@@ -10,26 +10,25 @@
 //   p_global_robot = p_global_antenna − R_global_robot · p_robot_antenna.
 //
 // Storage is preallocated (capacity per stream); the oldest samples are dropped first.
+#include <Eigen/Geometry>
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
 #include <vector>
 
-#include <Eigen/Geometry>
-
 namespace trajroi::pose {
 
 // Quality of a GNSS fix, as the receiver reported it (u-blox NAV-PVT semantics).
 struct FixQuality {
-  std::uint8_t fix_type = 0;    // 0 none, 1 DR, 2 2-D, 3 3-D, 4 GNSS+DR, 5 time only
+  std::uint8_t fix_type = 0;  // 0 none, 1 DR, 2 2-D, 3 3-D, 4 GNSS+DR, 5 time only
   bool gnss_fix_ok = false;
   double h_acc_m = 1e9;
-  bool rtk_fixed = false;       // carrier solution fixed
+  bool rtk_fixed = false;  // carrier solution fixed
   bool rtk_float = false;
 };
 
 struct GnssFix {
-  std::int64_t t_ns = 0;                     // host monotonic time of the epoch
+  std::int64_t t_ns = 0;  // host monotonic time of the epoch
   Eigen::Vector3d antenna_global_m = Eigen::Vector3d::Zero();
   FixQuality quality;
 };
@@ -40,7 +39,7 @@ struct AttitudeSample {
 };
 
 struct PoseGate {
-  std::uint8_t min_fix_type = 3;           // 3-D (4 = GNSS + dead reckoning also passes)
+  std::uint8_t min_fix_type = 3;  // 3-D (4 = GNSS + dead reckoning also passes)
   bool require_gnss_fix_ok = true;
   double max_h_acc_m = 0.5;
   bool require_rtk_fixed = false;
@@ -55,9 +54,9 @@ enum class PoseStatus : std::uint8_t {
   kBeforeFirstSample,  // t precedes the oldest sample kept
   kGnssTooOld,         // t is past the newest fix by more than max_extrapolation_ns
   kAttitudeTooOld,
-  kGnssGap,            // the fixes around t are further apart than max_gap_ns
+  kGnssGap,  // the fixes around t are further apart than max_gap_ns
   kAttitudeGap,
-  kFixTypeTooLow,      // a fix used fails the gate …
+  kFixTypeTooLow,  // a fix used fails the gate …
   kNoGnssFixOk,
   kAccuracyTooLow,
   kNotRtkFixed,
@@ -74,8 +73,8 @@ struct PoseQuery {
 struct PoseBufferCounters {
   std::uint64_t fixes = 0;
   std::uint64_t attitudes = 0;
-  std::uint64_t out_of_order = 0;   // older than or as old as the newest sample of its stream
-  std::uint64_t non_finite = 0;     // NaN / infinite values
+  std::uint64_t out_of_order = 0;  // older than or as old as the newest sample of its stream
+  std::uint64_t non_finite = 0;    // NaN / infinite values
 };
 
 class PoseBuffer {

@@ -9,8 +9,8 @@
 #include "trajroi/roi/centres.hpp"
 #include "trajroi/roi/filter_stats.hpp"
 #include "trajroi/roi/metrics.hpp"
-#include "trajroi/roi/shapes.hpp"
 #include "trajroi/roi/point.hpp"
+#include "trajroi/roi/shapes.hpp"
 #include "trajroi/roi/trajectory.hpp"
 
 namespace trajroi::eval {
@@ -49,8 +49,8 @@ struct ArtificialRow {
   double spacing_m;
   std::vector<roi::Centre> centres;
   roi::Confusion confusion;
-  roi::IndexVector kept;  // the fast filter's output
-  bool fast_equals_reference;       // kept indices identical, point for point
+  roi::IndexVector kept;       // the fast filter's output
+  bool fast_equals_reference;  // kept indices identical, point for point
   TimingStats reference;
   TimingStats fast;
 };
@@ -58,7 +58,6 @@ struct ArtificialRow {
 // One row of Table 3 (circular) or Table 5 (rectangular): centres from arc length 0 to the
 // end, spacing ratio × diameter (circular) or × height (rectangular); each method timed over
 // `reps` calls (centre geometry, and the grid for the fast one, included in every call).
-[[nodiscard]] ArtificialRow run_artificial_row(const ArtificialScene& scene, RoiShape shape,
-                                               int ratio_pct, int reps);
+[[nodiscard]] ArtificialRow run_artificial_row(const ArtificialScene& scene, RoiShape shape, int ratio_pct, int reps);
 
 }  // namespace trajroi::eval

@@ -12,10 +12,10 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
-#include <span>
-#include <string_view>
 #include <memory>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "trajroi/daemon/config.hpp"
@@ -161,13 +161,13 @@ class TruthCorridor {
 
 struct KeyframeCase {
   sim::Keyframe keyframe;
-  std::int64_t time_ns = 0;         // when the true robot is nearest the keyframe pose
+  std::int64_t time_ns = 0;  // when the true robot is nearest the keyframe pose
   std::uint64_t frame_index = 0;
-  std::vector<roi::PointXYZI> points;   // global frame, placed by the daemon's pipeline
-  std::vector<roi::PointXYZd> truth;    // global frame, true pose
+  std::vector<roi::PointXYZI> points;                            // global frame, placed by the daemon's pipeline
+  std::vector<roi::PointXYZd> truth;                             // global frame, true pose
   Eigen::Isometry3d robot_pose = Eigen::Isometry3d::Identity();  // estimated, at time_ns
-  double s0_m = 0.0;                // the robot's projection on the trajectory at the sweep's start
-  vlp16::Frame frame;               // as decoded (sensor frame)
+  double s0_m = 0.0;   // the robot's projection on the trajectory at the sweep's start
+  vlp16::Frame frame;  // as decoded (sensor frame)
 };
 
 // Finds each keyframe's frame and prepares it: its points placed by the daemon's pipeline, the
@@ -194,25 +194,25 @@ struct KeyframeRow {
 // of the ends). Time: the processor's time on the sweep's packets (decode, pose, transform,
 // chain, grid and filter) over `reps` passes of the run.
 [[nodiscard]] std::vector<KeyframeRow> run_keyframe_rows(const ScenarioRun& run, const std::vector<KeyframeCase>& cases,
-                                                         std::span<const RoiShape> shapes, std::span<const int> ratios_pct,
-                                                         int reps, PoseMode mode);
+                                                         std::span<const RoiShape> shapes,
+                                                         std::span<const int> ratios_pct, int reps, PoseMode mode);
 // One row (one pass per repetition).
-[[nodiscard]] KeyframeRow run_keyframe_row(const ScenarioRun& run, const KeyframeCase& c, RoiShape shape,
-                                           int ratio_pct, int reps, PoseMode mode);
+[[nodiscard]] KeyframeRow run_keyframe_row(const ScenarioRun& run, const KeyframeCase& c, RoiShape shape, int ratio_pct,
+                                           int reps, PoseMode mode);
 
 // ---- Table 18: sequential frames ------------------------------------------------------------
 
 struct FrameTiming {
   std::uint64_t frame_index;
-  double start_s;           // after the first frame
-  double cycle_ms;          // since the previous frame's start (0 for the first)
+  double start_s;   // after the first frame
+  double cycle_ms;  // since the previous frame's start (0 for the first)
   std::size_t points;
   double circular_ms;
   double rectangular_ms;
 };
 
 struct SequentialReport {
-  std::size_t frames = 0;            // complete frames with a valid pose
+  std::size_t frames = 0;  // complete frames with a valid pose
   std::size_t skipped_no_pose = 0;
   std::size_t skipped_partial = 0;
   double avg_points = 0.0;

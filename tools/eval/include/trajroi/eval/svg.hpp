@@ -18,15 +18,12 @@ class SvgCanvas {
  public:
   // The drawing covers [x_min, x_max] × [y_min, y_max] plus a margin, at px_per_m. The title
   // may hold one '\n': the text after it becomes a smaller second line.
-  SvgCanvas(double x_min, double y_min, double x_max, double y_max, double px_per_m,
-            std::string_view title);
+  SvgCanvas(double x_min, double y_min, double x_max, double y_max, double px_per_m, std::string_view title);
 
   void dot(double x, double y, std::string_view colour, double size_px = 2.0);
   void circle(double cx, double cy, double radius_m, std::string_view colour, double width_px = 1.0);
-  void polygon(std::span<const Eigen::Vector2d> corners, std::string_view colour,
-               double width_px = 1.0);
-  void polyline(std::span<const Eigen::Vector2d> points, std::string_view colour,
-                double width_px = 1.5);
+  void polygon(std::span<const Eigen::Vector2d> corners, std::string_view colour, double width_px = 1.0);
+  void polyline(std::span<const Eigen::Vector2d> points, std::string_view colour, double width_px = 1.5);
   // A legend entry in the header's legend row, one per call, left to right.
   void legend(std::string_view colour, std::string_view label);
 
@@ -38,8 +35,8 @@ class SvgCanvas {
 
  private:
   // <polygon> or <polyline> through the points, unfilled.
-  void path_element(const char* tag, std::span<const Eigen::Vector2d> points,
-                    std::string_view colour, double width_px, double opacity);
+  void path_element(const char* tag, std::span<const Eigen::Vector2d> points, std::string_view colour, double width_px,
+                    double opacity);
   [[nodiscard]] double px(double x) const noexcept { return (x - x_min_) * scale_ + kMargin; }
   [[nodiscard]] double py(double y) const noexcept { return (y_max_ - y) * scale_ + kMargin + kHeader; }
 
@@ -80,10 +77,10 @@ class SvgChart {
 };
 
 // Colours used for classified points everywhere, so pictures read the same.
-inline constexpr std::string_view kColourTp = "#2ca02c";   // kept, in the truth corridor
-inline constexpr std::string_view kColourFp = "#d62728";   // kept, outside it
-inline constexpr std::string_view kColourFn = "#ff7f0e";   // missed
-inline constexpr std::string_view kColourTn = "#c7c7c7";   // rightly dropped
+inline constexpr std::string_view kColourTp = "#2ca02c";  // kept, in the truth corridor
+inline constexpr std::string_view kColourFp = "#d62728";  // kept, outside it
+inline constexpr std::string_view kColourFn = "#ff7f0e";  // missed
+inline constexpr std::string_view kColourTn = "#c7c7c7";  // rightly dropped
 inline constexpr std::string_view kColourRoi = "#1f77b4";
 inline constexpr std::string_view kColourTrajectory = "#000000";
 inline constexpr std::string_view kColourRaw = "#7f7f7f";

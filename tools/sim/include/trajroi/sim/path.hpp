@@ -13,8 +13,8 @@ namespace trajroi::sim {
 
 struct PathPose {
   Eigen::Vector2d position_m;
-  double heading_rad;   // counter-clockwise from +x
-  double curvature;     // 1/m, positive turning left
+  double heading_rad;  // counter-clockwise from +x
+  double curvature;    // 1/m, positive turning left
 };
 
 class Path {

@@ -100,23 +100,23 @@ struct GnssFault {
 
 struct GnssSpec {
   double rate_hz = 8.0;
-  double latency_s = 0.02;      // epoch → first byte on the wire
+  double latency_s = 0.02;  // epoch → first byte on the wire
   double baud = 115'200.0;
-  double noise_h_m = 0.0;       // standard deviation of the horizontal error (first-order
-  double noise_v_m = 0.0;       // Gauss–Markov, correlation time below), per axis
+  double noise_h_m = 0.0;  // standard deviation of the horizontal error (first-order
+  double noise_v_m = 0.0;  // Gauss–Markov, correlation time below), per axis
   double correlation_s = 10.0;
-  double h_acc_m = 0.014;       // reported accuracy while healthy (RTK fixed)
+  double h_acc_m = 0.014;  // reported accuracy while healthy (RTK fixed)
   std::vector<GnssFault> faults;
 };
 
 struct ImuSpec {
-  int rate_divisor = 13;            // VN-100 async output: 800 Hz / divisor (13: 61.5 Hz)
+  int rate_divisor = 13;  // VN-100 async output: 800 Hz / divisor (13: 61.5 Hz)
   double latency_s = 0.0;
   double baud = 115'200.0;
-  double angle_noise_deg = 0.0;     // white noise on yaw, pitch, roll
+  double angle_noise_deg = 0.0;  // white noise on yaw, pitch, roll
   double gyro_noise_rps = 0.0;
   double accel_noise_mps2 = 0.0;
-  double heading_bias_deg = 0.0;    // constant error of the reported yaw
+  double heading_bias_deg = 0.0;          // constant error of the reported yaw
   double magnetic_declination_deg = 0.0;  // the VN-100 reports magnetic yaw
 };
 
@@ -143,9 +143,9 @@ struct Keyframe {
 // The evaluation's set-up (the paper's Section III-B uses the factory values below).
 struct EvaluationSpec {
   double circle_diameter_m = 28.0;
-  double rect_height_m = 12.0;  // a, along the trajectory
-  double rect_width_m = 28.0;   // b, across
-  double look_ahead_m = 42.0;   // the ROI chain's length from the robot's projection
+  double rect_height_m = 12.0;     // a, along the trajectory
+  double rect_width_m = 28.0;      // b, across
+  double look_ahead_m = 42.0;      // the ROI chain's length from the robot's projection
   double corridor_width_m = 28.0;  // the ground-truth corridor of truth/labels.bin
   double cuboid_length_m = 100.0;  // the long-cuboid baseline (Table 20)
   double cuboid_width_m = 12.0;
@@ -157,7 +157,7 @@ struct Scenario {
   std::string name;
   std::uint64_t seed = 1;
   std::int64_t start_utc_ns = 0;  // first firing
-  pose::Geodetic origin;           // of the global ENU frame
+  pose::Geodetic origin;          // of the global ENU frame
   WorldSpec world;
   PathSpec path;
   RobotSpec robot;

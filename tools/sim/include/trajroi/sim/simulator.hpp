@@ -48,7 +48,7 @@ struct SimulationStats {
   std::uint64_t data_packets = 0;
   std::uint64_t position_packets = 0;
   std::uint64_t rays = 0;
-  std::uint64_t points = 0;          // returns the decoder will give
+  std::uint64_t points = 0;  // returns the decoder will give
   std::uint64_t points_in_corridor = 0;
   std::uint64_t gnss_epochs = 0;
   std::uint64_t imu_frames = 0;

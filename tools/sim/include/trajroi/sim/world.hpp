@@ -14,7 +14,7 @@
 namespace trajroi::sim {
 
 struct Hit {
-  double range_m;            // along the (unit) direction from the origin
+  double range_m;  // along the (unit) direction from the origin
   std::uint8_t reflectivity;
 };
 
