@@ -146,8 +146,9 @@ TEST(Pipeline, ThreeFakeInputLanesThroughTheThreadsGiveTheProcessorsOwnSweeps) {
   // As live: one lane per stream (the lidar, the GNSS and the IMU source each with its thread).
   // exact: a full ring waits (an as-fast-as-possible replay), so nothing may be dropped.
   Pipeline pipeline(config, /*exact=*/true, /*record=*/false);
-  // Paced at 10x real time, as three sensors would deliver (each lane its own pacer).
-  constexpr double kRate = 10.0;
+  // Paced at 5x real time, as three sensors would deliver (each lane its own pacer), slow
+  // enough for ThreadSanitizer's processing to keep up.
+  constexpr double kRate = 5.0;
   pipeline.add_input(std::make_unique<FakeInput>(run_items({true, false, false}), kRate), 64, "test-lidar", {});
   pipeline.add_input(std::make_unique<FakeInput>(run_items({false, true, false}), kRate), 64, "test-gnss", {});
   pipeline.add_input(std::make_unique<FakeInput>(run_items({false, false, true}), kRate), 64, "test-imu", {});
