@@ -42,7 +42,9 @@ struct WatchOptions {
 class TruthScorer {
  public:
   explicit TruthScorer(const fs::path& dir)
-      : run_(dir), source_(dir / sim::kLidarFile), decoder_(vlp16::Calibration::vlp16_default(), options(run_)) {}
+      : run_(dir),
+        source_(dir / sim::kLidarFile),
+        decoder_(vlp16::Calibration::vlp16_default(), run_.stream_options()) {}
 
   void score(const trajroi::points_t& m, const trajroi::roi_t& roi) {
     const vlp16::Frame* frame = frame_at(static_cast<std::uint64_t>(m.sweep_index));
@@ -81,12 +83,6 @@ class TruthScorer {
   [[nodiscard]] std::size_t scored() const noexcept { return scored_; }
 
  private:
-  static vlp16::StreamOptions options(const eval::ScenarioRun& run) {
-    vlp16::StreamOptions o;
-    o.decode.min_range_m = run.scenario().lidar.min_range_m;
-    o.decode.max_range_m = run.scenario().lidar.max_range_m;
-    return o;
-  }
   const vlp16::Frame* frame_at(std::uint64_t index) {
     struct Keep final : vlp16::FrameSink {
       std::deque<vlp16::Frame>* frames;
