@@ -72,7 +72,7 @@ struct FieldReader {
   void i32(std::size_t at, std::int32_t& v) const noexcept { v = le_i32(p, at); }
   void flag(std::size_t at, unsigned mask, bool& v) const noexcept { v = (p[at] & mask) != 0; }
   void carrier(std::size_t at, unsigned shift, CarrierSolution& v) const noexcept {
-    v = carrier_solution(p[at] >> shift);
+    v = carrier_solution(static_cast<unsigned>(p[at]) >> shift);
   }
 };
 
