@@ -101,6 +101,10 @@ int run_pipeline(Pipeline& pipeline, SweepProcessor& processor, Outlet& outlet, 
   ProcessingOptions processing;
   processing.stall_after_s = options.stall_processing_after_s;
 
+  // Said from this thread before any other starts (which also sets up the logger once).
+  for (const auto& lane : pipeline.inputs)
+    log::info("input: {} ({})", lane->source->describe(), lane->thread_name);
+
   std::vector<std::thread> threads;
   threads.emplace_back([&] { processing_loop(pipeline, processor, processing); });
   threads.emplace_back([&] { publisher.run(); });
