@@ -71,7 +71,8 @@ void input_loop(Pipeline& pipeline, InputLane& lane) {
     }
     // One slot per datagram; serial bytes in slot-sized pieces with the same receive time.
     std::span<const std::uint8_t> rest = item.bytes;
-    if (inputs::is_lidar(item.stream) && rest.size() > kMaxItemBytes) continue;  // counted by the source
+    // A datagram is never split: the source drops (and counts) longer ones; this guards the slot.
+    if (inputs::is_lidar(item.stream) && rest.size() > kMaxItemBytes) continue;
     do {
       const auto piece = rest.first(std::min(kMaxItemBytes, rest.size()));
       rest = rest.subspan(piece.size());

@@ -28,8 +28,8 @@ namespace trajroi::daemon {
 template <typename T>
 using Ring = transport::SpscRing<T>;
 
-inline constexpr std::size_t kMaxItemBytes = 1500;  // Ethernet MTU: a VLP-16 packet is 1206
-inline constexpr int kIdleWait_ms = 100;            // every loop wakes at least this often
+inline constexpr std::size_t kMaxItemBytes = inputs::kMaxDatagramBytes;  // a slot holds any datagram
+inline constexpr int kIdleWait_ms = 100;                                 // every loop wakes at least this often
 
 // CLOCK_MONOTONIC and the calling thread's CPU time, ns.
 [[nodiscard]] std::int64_t steady_ns() noexcept;

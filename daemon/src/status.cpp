@@ -91,7 +91,6 @@ std::uint64_t StatusSnapshot::ring_drops() const noexcept {
 
 void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64_t last_lidar_receive_ns, bool final,
                    StatusSnapshot& s) {
-  (void)names();  // built before the first status, off the hot path
   const vlp16::StreamCounters& l = p.lidar_counters();
   s.steady_ns = steady_ns();
   s.final = final;

@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <array>
-#include <fstream>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 
 #include "trajroi/config/text_file.hpp"
@@ -36,6 +34,12 @@ vlp16::StreamOptions stream_options(const DaemonConfig& c) {
   return o;
 }
 
+double size_along(const DaemonConfig::Roi& r) {
+  return r.shape == RoiShape::kCircular ? r.circle_diameter_m : r.rect_height_m;
+}
+
+}  // namespace
+
 pose_input::PoseInputConfig pose_input_config(const DaemonConfig& c) {
   pose_input::PoseInputConfig p;
   p.imu.robot_from_imu = c.robot_from_imu;
@@ -44,12 +48,6 @@ pose_input::PoseInputConfig pose_input_config(const DaemonConfig& c) {
   p.imu_delay_ns = std::llround(c.imu.delay_s * 1e9);
   return p;
 }
-
-double size_along(const DaemonConfig::Roi& r) {
-  return r.shape == RoiShape::kCircular ? r.circle_diameter_m : r.rect_height_m;
-}
-
-}  // namespace
 
 PublishedPose PublishedPose::from(const Eigen::Isometry3d& pose) {
   PublishedPose p;

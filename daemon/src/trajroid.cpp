@@ -41,7 +41,6 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
   udp.receive_buffer_bytes = config.lidar.receive_buffer_bytes;
   udp.sensor_address = config.lidar.sensor_address;
   auto lidar = std::make_unique<inputs::UdpInput>(udp);
-  log::info("lidar: {}", lidar->describe());
   pipeline.add_input(std::move(lidar), config.buffers.lidar_packets, "trajroid-lidar", config.realtime.lidar);
   const auto add_serial = [&](const DaemonConfig::Serial& s, const char* name, inputs::Stream stream,
                               const ThreadConfig& thread) {
@@ -54,7 +53,6 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
     o.baud = s.baud;
     // A receiver that comes back (cable, USB re-enumeration) is read again within 0.5 s.
     o.max_backoff = std::chrono::milliseconds(500);
-    log::info("{}: {} at {} baud", name, s.device, s.baud);
     pipeline.add_input(std::make_unique<inputs::SerialInput>(name, stream, o), config.buffers.serial_chunks,
                        std::string("trajroid-") + name, thread);
   };

@@ -18,18 +18,4 @@ std::int64_t realtime_ns() noexcept {
   return clock_ns(CLOCK_REALTIME);
 }
 
-std::string_view to_string(Stream stream) noexcept {
-  switch (stream) {
-    case Stream::kLidarData:
-      return "lidar data";
-    case Stream::kLidarPosition:
-      return "lidar position";
-    case Stream::kGnss:
-      return "gnss";
-    case Stream::kImu:
-      return "imu";
-  }
-  return "?";
-}
-
 }  // namespace trajroi::inputs

@@ -2,10 +2,6 @@
 
 namespace trajroi::inputs {
 
-namespace {
-constexpr std::size_t kMaxDatagram = 1500;  // Ethernet MTU: a VLP-16 packet is 1206
-}
-
 // ---- UDP ------------------------------------------------------------------------------------
 
 UdpInput::UdpInput(const vlp16::UdpOptions& options) : udp_(std::make_unique<vlp16::UdpSource>(options)) {
@@ -42,7 +38,7 @@ UdpInput::Next UdpInput::next(InputItem& item, std::chrono::milliseconds timeout
       ++errors_;
       return Next::kError;
     }
-    if (d.payload.size() > kMaxDatagram) {
+    if (d.payload.size() > kMaxDatagramBytes) {
       ++oversize_;
       timeout = std::chrono::milliseconds(0);
       continue;

@@ -10,10 +10,6 @@ namespace trajroi::inputs {
 
 namespace fs = std::filesystem;
 
-namespace {
-constexpr std::size_t kMaxDatagram = 1500;  // Ethernet MTU: a VLP-16 packet is 1206
-}
-
 RunMerger::RunMerger(const fs::path& dir, RunStreams streams, std::int64_t shift_ns) : shift_ns_(shift_ns) {
   if (streams.lidar) {
     vlp16::PcapOptions options;
@@ -47,7 +43,7 @@ void RunMerger::fill_lidar() {
       if (r == vlp16::PacketSource::Next::kError) error_ = pcap_->error();
       return;
     }
-    if (d.payload.size() > kMaxDatagram) {
+    if (d.payload.size() > kMaxDatagramBytes) {
       ++oversize_;
       continue;
     }

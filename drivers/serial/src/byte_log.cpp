@@ -6,7 +6,6 @@
 #include <cstring>
 #include <fstream>
 #include <stdexcept>
-#include <thread>
 
 #include "trajroi/framing/little_endian.hpp"
 #include "trajroi/ublox/framer.hpp"

@@ -6,11 +6,9 @@
 #include <cmath>
 #include <limits>
 #include <map>
-#include <numbers>
 #include <stdexcept>
 
 #include "trajroi/config/text_file.hpp"
-#include "trajroi/config/yaml_reader.hpp"
 #include "trajroi/daemon/sweep_processor.hpp"
 #include "trajroi/inputs/capture.hpp"
 #include "trajroi/inputs/run_merger.hpp"
@@ -22,15 +20,6 @@
 namespace trajroi::eval {
 namespace fs = std::filesystem;
 namespace {
-
-template <typename Point>
-void push_point(std::vector<Point>& out, const Eigen::Vector3d& p, float intensity) {
-  if constexpr (std::is_same_v<Point, roi::PointXYZI>) {
-    out.push_back({static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()), intensity});
-  } else {
-    out.push_back({p.x(), p.y(), p.z()});
-  }
-}
 
 double elapsed_ms(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
@@ -84,12 +73,8 @@ ScenarioRun::ScenarioRun(const fs::path& dir) : dir_(dir) {
   // GNSS position).
   const std::size_t capacity = 1U << 20;
   poses_ = std::make_unique<pose::PoseBuffer>(config_.gate, config_.gnss_antenna_m, capacity);
-  pose_input::PoseInputConfig input_config;
-  input_config.imu.robot_from_imu = config_.robot_from_imu;
-  input_config.imu.magnetic_declination_deg = config_.magnetic_declination_deg;
-  input_config.gnss_delay_ns = std::llround(config_.gnss.delay_s * 1e9);
-  input_config.imu_delay_ns = std::llround(config_.imu.delay_s * 1e9);
-  pose_input::PoseInput input(pose::GlobalFrame::local_cartesian(config_.origin), input_config, *poses_);
+  pose_input::PoseInput input(pose::GlobalFrame::local_cartesian(config_.origin), daemon::pose_input_config(config_),
+                              *poses_);
   inputs::RunMerger merger(dir, inputs::RunStreams{false, true, true});
   inputs::InputItem item;
   while (merger.next(item)) {
@@ -155,10 +140,6 @@ vlp16::StreamCounters ScenarioRun::for_each_frame(const FrameCallback& on_frame)
     sink.decode_ms += elapsed_ms(start);
   }
   return decoder.counters();
-}
-
-std::string_view to_string(PoseMode mode) noexcept {
-  return mode == PoseMode::kPerSweep ? "per-sweep" : "per-firing";
 }
 
 // ---- the daemon's pipeline ------------------------------------------------------------------
@@ -239,10 +220,9 @@ void place_frame_truth(const vlp16::Frame& frame, const sim::TruthPoses& truth,
   for (const vlp16::Point& p : frame.points) {
     const sim::TruePose tp = truth.at(frame.start_time_ns + p.time_offset_ns);
     const Eigen::Isometry3d global_from_lidar = roi::pose_from_xy_yaw(tp.x_m, tp.y_m, tp.yaw_rad) * robot_from_lidar;
-    push_point(out,
-               global_from_lidar *
-                   Eigen::Vector3d(static_cast<double>(p.x), static_cast<double>(p.y), static_cast<double>(p.z)),
-               0.0f);
+    const Eigen::Vector3d g = global_from_lidar * Eigen::Vector3d(static_cast<double>(p.x), static_cast<double>(p.y),
+                                                                  static_cast<double>(p.z));
+    out.push_back({g.x(), g.y(), g.z()});
   }
 }
 

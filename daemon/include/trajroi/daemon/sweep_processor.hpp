@@ -123,6 +123,9 @@ struct ProcessorCounters {
   std::uint64_t projection_reacquired = 0;  // the robot far from where progress along the trajectory put it
 };
 
+// How the configuration sets up the pose input (IMU mounting and declination, the delays).
+[[nodiscard]] pose_input::PoseInputConfig pose_input_config(const DaemonConfig& config);
+
 class SweepProcessor {
  public:
   SweepProcessor(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> trajectory);

@@ -20,10 +20,13 @@ enum class Stream : std::uint8_t {
   kImu,            // bytes from the IMU (VN-100 binary)
 };
 inline constexpr std::size_t kStreamCount = 4;
-[[nodiscard]] std::string_view to_string(Stream stream) noexcept;
 [[nodiscard]] constexpr bool is_lidar(Stream s) noexcept {
   return s == Stream::kLidarData || s == Stream::kLidarPosition;
 }
+
+// The longest LiDAR datagram an input hands out (the Ethernet MTU; a VLP-16 packet is 1206
+// bytes): longer ones are dropped and counted by the source (InputCounters::oversize).
+inline constexpr std::size_t kMaxDatagramBytes = 1500;
 
 struct InputItem {
   Stream stream = Stream::kLidarData;

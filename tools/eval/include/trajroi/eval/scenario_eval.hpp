@@ -79,7 +79,6 @@ class ScenarioRun {
 // How a sweep's points get their pose: one per firing sequence (55.3 µs, motion-compensated)
 // or one for the whole sweep, at its start (the paper's way): the daemon's pose.mode.
 using daemon::PoseMode;
-[[nodiscard]] std::string_view to_string(PoseMode mode) noexcept;
 
 // What one pass of the daemon's pipeline over the run reports.
 class PipelineObserver {
