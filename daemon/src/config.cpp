@@ -1,8 +1,10 @@
 #include "trajroi/daemon/config.hpp"
 
 #include <arpa/inet.h>
+#include <sys/stat.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <numbers>
@@ -10,7 +12,9 @@
 
 #include "trajroi/config/origin.hpp"
 #include "trajroi/config/text_file.hpp"
+#include "trajroi/pose/attitude.hpp"
 #include "trajroi/roi/transform.hpp"
+#include "trajroi/serial/serial_port_source.hpp"
 
 namespace trajroi::daemon {
 namespace {
@@ -48,6 +52,12 @@ std::string ipv4(MapReader& m, std::string_view key, const char* fallback, bool 
   return text;
 }
 
+// A number, or `none` (also when the key is left out).
+std::optional<double> optional_number(MapReader& m, std::string_view key) {
+  if (m.text(key, "none") == "none") return std::nullopt;
+  return m.number(key);
+}
+
 Eigen::Isometry3d read_mounting(MapReader m) {
   const auto xyz = m.numbers("xyz", {0.0, 0.0, 0.0});
   const double roll = m.number("roll_deg", 0.0) * kDegToRad;
@@ -59,8 +69,14 @@ Eigen::Isometry3d read_mounting(MapReader m) {
 
 void read_serial(MapReader& m, DaemonConfig::Serial& s) {
   s.device = m.text("device", "");
+  // A device that does not exist yet is no configuration error (a USB receiver can appear
+  // after the daemon starts: a run-time fault, said and retried); one that exists must be
+  // a terminal or serial device.
+  struct stat st {};
+  m.require(s.device.empty() || ::stat(s.device.c_str(), &st) != 0 || S_ISCHR(st.st_mode), "device",
+            "exists but is not a character device (a serial port or pseudo-terminal)");
   s.baud = static_cast<int>(m.integer("baud", 115200));
-  m.require(s.baud >= 1200 && s.baud <= 4'000'000, "baud", "must be a serial baud rate (1200 … 4000000)");
+  m.require(serial::is_supported_baud(s.baud), "baud", "must be one of " + serial::supported_bauds_text());
   s.delay_s = m.number("delay_s", 0.0);
   m.require(s.delay_s >= 0.0 && s.delay_s < 1.0, "delay_s", "must be in [0, 1) s");
 }
@@ -89,6 +105,64 @@ ThreadConfig read_thread(MapReader& parent, std::string_view key) {
 
 }  // namespace
 
+std::string check_lcm_url(const std::string& url) {
+  const std::size_t scheme_end = url.find("://");
+  if (scheme_end == std::string::npos) return "must be an LCM URL, provider://[address[:port]][?options]";
+  const std::string provider = url.substr(0, scheme_end);
+  if (provider != "udpm" && provider != "memq" && provider != "file" && provider != "tcpq") {
+    return "provider '" + provider + "' is not one of udpm, memq, file, tcpq";
+  }
+  if (provider != "udpm") return {};
+  const std::string rest = url.substr(scheme_end + 3);
+  const std::string target = rest.substr(0, rest.find('?'));
+  const std::string options = rest.find('?') == std::string::npos ? "" : rest.substr(rest.find('?') + 1);
+  const std::string address = target.substr(0, target.find(':'));
+  if (!address.empty()) {
+    in_addr parsed{};
+    if (inet_pton(AF_INET, address.c_str(), &parsed) != 1) return "address '" + address + "' is not an IPv4 address";
+    const std::uint32_t first = ntohl(parsed.s_addr) >> 24;
+    if (first < 224 || first > 239) return "address '" + address + "' is not a multicast address (224–239.x.x.x)";
+  }
+  const auto whole_number = [](const std::string& text, long lo, long hi) {
+    if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos || text.size() > 9) return false;
+    const long v = std::stol(text);
+    return v >= lo && v <= hi;
+  };
+  if (target.find(':') != std::string::npos) {
+    const std::string port_text = target.substr(target.find(':') + 1);
+    if (!whole_number(port_text, 1, 65535)) return "port '" + port_text + "' is not a UDP port 1 … 65535";
+  }
+  std::size_t at = 0;
+  while (at < options.size()) {
+    const std::size_t end = std::min(options.find('&', at), options.size());
+    const std::string option = options.substr(at, end - at);
+    const std::size_t eq = option.find('=');
+    const std::string key = option.substr(0, eq);
+    const std::string value = eq == std::string::npos ? "" : option.substr(eq + 1);
+    if (key == "ttl") {
+      if (!whole_number(value, 0, 255)) return "ttl '" + value + "' is not 0 … 255";
+    } else if (key == "recv_buf_size") {
+      if (!whole_number(value, 1, 1 << 30)) return "recv_buf_size '" + value + "' is not a byte count";
+    } else {
+      return "option '" + key + "' is not one of ttl, recv_buf_size";
+    }
+    at = end + 1;
+  }
+  return {};
+}
+
+std::string_view to_string(PoseSource source) noexcept {
+  switch (source) {
+    case PoseSource::kGnssImu:
+      return "gnss_imu";
+    case PoseSource::kGnss:
+      return "gnss";
+    case PoseSource::kFixed:
+      return "fixed";
+  }
+  return "unknown";
+}
+
 DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::path& file) {
   DaemonConfig c;
   c.file = file;
@@ -104,10 +178,13 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
   {
     MapReader t = r.map("trajectory");
     c.trajectory_file = resolve(dir, t.text("file"));
+    c.trajectory_coordinates = t.choice("coordinates", {"global_xy", "lat_lon"}, "global_xy") == "lat_lon"
+                                   ? TrajectoryCoordinates::kLatLon
+                                   : TrajectoryCoordinates::kGlobalXy;
     t.finish();
   }
   {
-    MapReader l = r.map("lidar");
+    MapReader l = r.map("lidar", true);
     (void)l.choice("model", {"VLP-16"}, "VLP-16");
     c.lidar.calibration = resolve(dir, l.text("calibration", ""));
     if (l.has("mounting")) c.lidar.robot_from_lidar = read_mounting(l.map("mounting"));
@@ -124,17 +201,18 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
     c.lidar.position_port = port(l, "position_port", 8308);
     c.lidar.receive_buffer_bytes =
         static_cast<int>(count(l, "receive_buffer_bytes", 4U << 20, 65536, std::size_t{1} << 30));
+    c.lidar.share_ports = l.boolean("share_ports", false);
     l.finish();
   }
   {
-    MapReader g = r.map("gnss");
+    MapReader g = r.map("gnss", true);
     read_serial(g, c.gnss);
     const auto a = g.numbers("antenna", {0.0, 0.0, 0.0});
     c.gnss_antenna_m = Eigen::Vector3d(a[0], a[1], a[2]);
     g.finish();
   }
   {
-    MapReader m = r.map("imu");
+    MapReader m = r.map("imu", true);
     read_serial(m, c.imu);
     c.magnetic_declination_deg = m.number("magnetic_declination_deg", 0.0);
     m.require(std::abs(c.magnetic_declination_deg) <= 180.0, "magnetic_declination_deg", "must be in [-180, 180]");
@@ -146,19 +224,41 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
   }
   {
     MapReader p = r.map("pose", true);
+    const std::string source = p.choice("source", {"gnss_imu", "gnss", "fixed"}, "gnss_imu");
+    c.pose_source = source == "gnss"    ? PoseSource::kGnss
+                    : source == "fixed" ? PoseSource::kFixed
+                                        : PoseSource::kGnssImu;
+    if (p.has("gnss_heading")) {
+      MapReader h = p.map("gnss_heading");
+      c.gnss_heading.min_speed_mps = h.positive("min_speed_mps", c.gnss_heading.min_speed_mps);
+      c.gnss_heading.max_heading_acc_deg = h.positive("max_heading_acc_deg", c.gnss_heading.max_heading_acc_deg);
+      c.gnss_heading.baseline_yaw_deg = h.number("baseline_yaw_deg", 0.0);
+      h.require(std::abs(c.gnss_heading.baseline_yaw_deg) <= 180.0, "baseline_yaw_deg", "must be in [-180, 180]");
+      c.gnss_heading.initial_heading_deg = optional_number(h, "initial_heading_deg");
+      if (const auto& b = c.gnss_heading.initial_heading_deg) {
+        h.require(*b >= 0.0 && *b < 360.0, "initial_heading_deg",
+                  "must be a true bearing in [0, 360) (clockwise from north), or none");
+      }
+      h.finish();
+    }
+    if (c.pose_source == PoseSource::kFixed) {
+      p.require(p.has("fixed"), "fixed", "must be given with source: fixed ({xyz: [x, y, z], yaw_deg: …})");
+    }
+    if (p.has("fixed")) c.fixed_pose = read_mounting(p.map("fixed"));
     const std::string mode = p.choice("mode", {"per_firing", "per_sweep"}, "per_firing");
     c.pose_mode = mode == "per_sweep" ? PoseMode::kPerSweep : PoseMode::kPerFiring;
     c.gate.min_fix_type = static_cast<std::uint8_t>(count(p, "min_fix_type", 3, 1, 5));
     c.gate.require_gnss_fix_ok = p.boolean("require_gnss_fix_ok", true);
-    c.gate.max_h_acc_m = p.positive("max_h_acc_m", 0.5);
+    c.gate.max_h_acc_m = p.positive("max_h_acc_m", c.gate.max_h_acc_m);
     c.gate.require_rtk_fixed = p.boolean("require_rtk_fixed", false);
-    c.gate.max_extrapolation_ns = std::llround(p.non_negative("max_extrapolation_s", 0.25) * 1e9);
+    c.gate.max_extrapolation_ns = std::llround(
+        p.non_negative("max_extrapolation_s", static_cast<double>(c.gate.max_extrapolation_ns) * 1e-9) * 1e9);
     c.gate.max_gap_ns = std::llround(p.positive("max_gap_s", 1.0) * 1e9);
     c.pose_capacity = count(p, "buffer_samples", 4096, 16, 1U << 20);
     p.finish();
   }
   {
-    MapReader o = r.map("roi");
+    MapReader o = r.map("roi", true);
     const std::string shape = o.choice("shape", {"circular", "rectangular"}, "circular");
     c.roi.shape = shape == "rectangular" ? RoiShape::kRectangular : RoiShape::kCircular;
     c.roi.circle_diameter_m = o.positive("circle_diameter_m", 28.0);
@@ -166,8 +266,8 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
     c.roi.rect_width_m = o.positive("rect_width_m", 28.0);
     c.roi.spacing_ratio = o.positive("spacing_ratio", 0.25);
     c.roi.look_ahead_m = o.non_negative("look_ahead_m", 42.0);
-    c.roi.z_min_m = o.number("z_min_m", -std::numeric_limits<double>::infinity());
-    c.roi.z_max_m = o.number("z_max_m", std::numeric_limits<double>::infinity());
+    c.roi.z_min_m = optional_number(o, "z_min_m").value_or(-std::numeric_limits<double>::infinity());
+    c.roi.z_max_m = optional_number(o, "z_max_m").value_or(std::numeric_limits<double>::infinity());
     o.require(c.roi.z_min_m <= c.roi.z_max_m, "z_max_m", "must be >= z_min_m");
     if (o.has("speed_scaling")) {
       MapReader s = o.map("speed_scaling");
@@ -184,6 +284,7 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
   {
     MapReader l = r.map("lcm", true);
     c.lcm.url = l.text("url", c.lcm.url);
+    if (const std::string problem = check_lcm_url(c.lcm.url); !problem.empty()) l.fail("url", problem);
     if (l.has("channels")) {
       MapReader ch = l.map("channels");
       const auto channel = [&ch](std::string_view key, std::string& name) {
@@ -229,6 +330,134 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
   }
   r.finish();
   return c;
+}
+
+namespace {
+
+std::string format_number(double v) {
+  if (std::isinf(v)) return "none";  // an absent limit
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", v);
+  return text;
+}
+
+// "[x, y, z]" (appended piecewise: GCC 12's -Wrestrict misfires on "[" + std::string).
+std::string format_vector(const Eigen::Vector3d& v) {
+  std::string out("[");
+  out.append(format_number(v.x())).append(", ").append(format_number(v.y())).append(", ");
+  out.append(format_number(v.z())).append("]");
+  return out;
+}
+
+std::string format_mounting(const Eigen::Isometry3d& t) {
+  const pose::RollPitchYaw rpy = pose::roll_pitch_yaw(Eigen::Quaterniond(t.linear()));
+  constexpr double kRadToDeg = 180.0 / std::numbers::pi;
+  std::string out("{xyz: ");
+  out.append(format_vector(t.translation())).append(", roll_deg: ").append(format_number(rpy.roll_rad * kRadToDeg));
+  out.append(", pitch_deg: ").append(format_number(rpy.pitch_rad * kRadToDeg));
+  out.append(", yaw_deg: ").append(format_number(rpy.yaw_rad * kRadToDeg)).append("}");
+  return out;
+}
+
+std::string format_thread(const ThreadConfig& t) {
+  std::string out = t.policy == SchedPolicy::kFifo ? "{policy: fifo"
+                    : t.policy == SchedPolicy::kRr ? "{policy: rr"
+                                                   : "{policy: other";
+  if (t.policy != SchedPolicy::kOther) out += ", priority: " + std::to_string(t.priority);
+  if (!t.cpus.empty()) {
+    out += ", cpus: [";
+    for (std::size_t i = 0; i < t.cpus.size(); ++i) {
+      if (i > 0) out.append(", ");
+      out.append(std::to_string(t.cpus[i]));
+    }
+    out += "]";
+  }
+  return out + "}";
+}
+
+}  // namespace
+
+std::string describe(const DaemonConfig& c) {
+  std::string out;
+  const auto line = [&out](std::string_view key, const std::string& value) {
+    out.append(key).append(": ").append(value).append("\n");
+  };
+  const auto num = [&line](std::string_view key, double v) { line(key, format_number(v)); };
+  const auto flag = [&line](std::string_view key, bool v) { line(key, v ? "true" : "false"); };
+
+  std::string origin("{lat_deg: ");
+  origin.append(format_number(c.origin.lat_deg)).append(", lon_deg: ").append(format_number(c.origin.lon_deg));
+  origin.append(", height_m: ").append(format_number(c.origin.height_m)).append("}");
+  line("global_frame.origin", origin);
+  line("trajectory.file", c.trajectory_file.string());
+  line("trajectory.coordinates", c.trajectory_coordinates == TrajectoryCoordinates::kLatLon ? "lat_lon" : "global_xy");
+  line("lidar.model", "VLP-16");
+  line("lidar.calibration", c.lidar.calibration.string());
+  line("lidar.mounting", format_mounting(c.lidar.robot_from_lidar));
+  num("lidar.min_range_m", c.lidar.min_range_m);
+  num("lidar.max_range_m", c.lidar.max_range_m);
+  num("lidar.cut_azimuth_deg", c.lidar.cut_azimuth_deg);
+  line("lidar.bind_address", c.lidar.bind_address);
+  line("lidar.sensor_address", c.lidar.sensor_address);
+  num("lidar.data_port", c.lidar.data_port);
+  num("lidar.position_port", c.lidar.position_port);
+  num("lidar.receive_buffer_bytes", c.lidar.receive_buffer_bytes);
+  flag("lidar.share_ports", c.lidar.share_ports);
+  const auto serial = [&](std::string_view name, const DaemonConfig::Serial& s) {
+    line(std::string(name) + ".device", s.device);
+    num(std::string(name) + ".baud", s.baud);
+    num(std::string(name) + ".delay_s", s.delay_s);
+  };
+  serial("gnss", c.gnss);
+  line("gnss.antenna", format_vector(c.gnss_antenna_m));
+  serial("imu", c.imu);
+  num("imu.magnetic_declination_deg", c.magnetic_declination_deg);
+  line("imu.mounting", format_mounting(Eigen::Isometry3d(c.robot_from_imu)));
+  line("pose.source", std::string(to_string(c.pose_source)));
+  num("pose.gnss_heading.min_speed_mps", c.gnss_heading.min_speed_mps);
+  num("pose.gnss_heading.max_heading_acc_deg", c.gnss_heading.max_heading_acc_deg);
+  num("pose.gnss_heading.baseline_yaw_deg", c.gnss_heading.baseline_yaw_deg);
+  line("pose.gnss_heading.initial_heading_deg",
+       c.gnss_heading.initial_heading_deg ? format_number(*c.gnss_heading.initial_heading_deg) : "none");
+  line("pose.fixed", format_mounting(c.fixed_pose));
+  line("pose.mode", c.pose_mode == PoseMode::kPerSweep ? "per_sweep" : "per_firing");
+  num("pose.min_fix_type", c.gate.min_fix_type);
+  flag("pose.require_gnss_fix_ok", c.gate.require_gnss_fix_ok);
+  num("pose.max_h_acc_m", c.gate.max_h_acc_m);
+  flag("pose.require_rtk_fixed", c.gate.require_rtk_fixed);
+  num("pose.max_extrapolation_s", static_cast<double>(c.gate.max_extrapolation_ns) * 1e-9);
+  num("pose.max_gap_s", static_cast<double>(c.gate.max_gap_ns) * 1e-9);
+  num("pose.buffer_samples", static_cast<double>(c.pose_capacity));
+  line("roi.shape", c.roi.shape == RoiShape::kRectangular ? "rectangular" : "circular");
+  num("roi.circle_diameter_m", c.roi.circle_diameter_m);
+  num("roi.rect_height_m", c.roi.rect_height_m);
+  num("roi.rect_width_m", c.roi.rect_width_m);
+  num("roi.spacing_ratio", c.roi.spacing_ratio);
+  num("roi.look_ahead_m", c.roi.look_ahead_m);
+  num("roi.z_min_m", c.roi.z_min_m);
+  num("roi.z_max_m", c.roi.z_max_m);
+  num("roi.speed_scaling.look_ahead_s", c.roi.look_ahead_per_mps_s);
+  num("roi.speed_scaling.width_s", c.roi.width_per_mps_s);
+  num("roi.speed_scaling.max_speed_mps", c.roi.max_speed_mps);
+  line("lcm.url", c.lcm.url);
+  line("lcm.channels.points", c.lcm.points);
+  line("lcm.channels.pose", c.lcm.pose);
+  line("lcm.channels.roi", c.lcm.roi);
+  line("lcm.channels.status", c.lcm.status);
+  line("lcm.channels.trajectory", c.lcm.trajectory);
+  num("buffers.lidar_packets", static_cast<double>(c.buffers.lidar_packets));
+  num("buffers.serial_chunks", static_cast<double>(c.buffers.serial_chunks));
+  num("buffers.sweeps", static_cast<double>(c.buffers.sweeps));
+  num("buffers.max_points_per_sweep", static_cast<double>(c.buffers.max_points_per_sweep));
+  line("logging.level", c.logging.level);
+  num("logging.warning_interval_s", c.logging.warning_interval_s);
+  flag("realtime.lock_memory", c.realtime.lock_memory);
+  line("realtime.threads.lidar", format_thread(c.realtime.lidar));
+  line("realtime.threads.gnss", format_thread(c.realtime.gnss));
+  line("realtime.threads.imu", format_thread(c.realtime.imu));
+  line("realtime.threads.processing", format_thread(c.realtime.processing));
+  line("realtime.threads.publisher", format_thread(c.realtime.publisher));
+  return out;
 }
 
 DaemonConfig load_daemon_config(const std::filesystem::path& file) {

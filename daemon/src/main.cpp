@@ -8,6 +8,7 @@
 
 #include "log.hpp"
 #include "reload.hpp"
+#include "trajroi/daemon/trajectory_file.hpp"
 #include "trajroid.hpp"
 
 int main(int argc, char** argv) {
@@ -49,6 +50,10 @@ int main(int argc, char** argv) {
     return kExitConfig;
   }
   options.loop = loop;
+  if (const std::string problem = check_lcm_url(lcm_url); !lcm_url.empty() && !problem.empty()) {
+    std::fprintf(stderr, "trajroid: --lcm-url '%s': %s\n", lcm_url.c_str(), problem.c_str());
+    return kExitConfig;
+  }
   options.lcm_url = lcm_url;
   if (stall_after_s >= 0.0) options.stall_processing_after_s = stall_after_s;
   if (rate == "max") {
@@ -68,16 +73,18 @@ int main(int argc, char** argv) {
   // The trajectory file is part of the configuration: read once, here.
   std::unique_ptr<ActiveTrajectory> trajectory;
   try {
-    trajectory = load_trajectory(config.trajectory_file);
+    trajectory = load_trajectory(TrajectorySource::from(config));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "trajroid: configuration error: %s: trajectory.file: %s: %s\n", config_file.c_str(),
                  config.trajectory_file.c_str(), e.what());
     return kExitConfig;
   }
   if (check_config) {
-    std::printf("%s: configuration OK (trajectory %s, ROI %s, pose %s, LCM %s)\n", config_file.c_str(),
-                config.trajectory_file.c_str(), config.roi.shape == RoiShape::kCircular ? "circular" : "rectangular",
-                config.pose_mode == PoseMode::kPerFiring ? "per firing" : "per sweep", config.lcm.url.c_str());
+    std::printf("%s", describe(config).c_str());
+    std::printf("%s: configuration OK (trajectory %s: %zu waypoints, %.1f m; pose from %s; LCM %s)\n",
+                config_file.c_str(), config.trajectory_file.c_str(), trajectory->trajectory.waypoints().size(),
+                trajectory->trajectory.length_m(), std::string(to_string(config.pose_source)).c_str(),
+                (lcm_url.empty() ? config.lcm.url : lcm_url).c_str());
     return 0;
   }
   log::init(config.logging.level);

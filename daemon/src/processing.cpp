@@ -1,5 +1,6 @@
 // The processing thread: every lane's items in their global order through the SweepProcessor;
 // finished sweeps to the publisher's ring; a status snapshot once a second and at the end.
+#include <algorithm>
 #include <chrono>
 #include <limits>
 #include <thread>
@@ -68,13 +69,13 @@ class Processing {
 
   void handle(InputLane& lane, InputSlot& item) {
     const std::span<const std::uint8_t> bytes(item.bytes.data(), item.size);
+    last_receive_ns_ = std::max(last_receive_ns_, item.receive_ns);
     switch (item.stream) {
       case inputs::Stream::kLidarData:
       case inputs::Stream::kLidarPosition: {
         const std::int64_t start = steady_ns();
         sink_.packet_started(start);
         processor_.set_input_arrival(item.arrival_ns);
-        last_lidar_receive_ns_ = item.receive_ns;
         processor_.lidar_datagram(item.stream == inputs::Stream::kLidarData ? LidarPort::kData : LidarPort::kPosition,
                                   bytes, item.receive_ns, sink_);
         sink_.packet_done(steady_ns());
@@ -114,7 +115,7 @@ class Processing {
 
   void snapshot(bool final) {
     const bool pushed = pipeline_.status->try_push(
-        [&](StatusSnapshot& s) { fill_snapshot(processor_, pipeline_, last_lidar_receive_ns_, final, s); });
+        [&](StatusSnapshot& s) { fill_snapshot(processor_, pipeline_, last_receive_ns_, final, s); });
     if (pushed) pipeline_.publish_wake.notify();
   }
 
@@ -164,7 +165,7 @@ class Processing {
   Pipeline& pipeline_;
   SweepProcessor& processor_;
   RingSink sink_;
-  std::int64_t last_lidar_receive_ns_ = 0;
+  std::int64_t last_receive_ns_ = 0;
 };
 
 }  // namespace

@@ -42,11 +42,12 @@ Publisher::Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, boo
       config_(pipeline.config),
       frame_(pose::GlobalFrame::local_cartesian(pipeline.config.origin)),
       start_steady_ns_(steady_ns()),
-      warn_limit_(pipeline.config.logging.warning_interval_s) {}
+      sweep_warn_limit_(pipeline.config.logging.warning_interval_s),
+      trajectory_warn_limit_(pipeline.config.logging.warning_interval_s) {}
 
-void Publisher::warn_rate_limited(const std::string& message) {
+void Publisher::warn_rate_limited(log::RateLimited& limit, const std::string& message) {
   std::uint64_t suppressed = 0;
-  if (warn_limit_.allow(steady_ns(), suppressed)) {
+  if (limit.allow(steady_ns(), suppressed)) {
     if (suppressed > 0) {
       log::warn("{} ({} similar warnings suppressed)", message, suppressed);
     } else {
@@ -73,8 +74,9 @@ void Publisher::on_trajectory_message(std::span<const std::uint8_t> bytes, const
   TrajectoryCheck check = decode_trajectory(bytes.data(), bytes.size(), frame_);
   if (check.reason != TrajectoryReject::kNone) {
     ++trajectory_rejects_[static_cast<std::size_t>(check.reason)];
-    warn_rate_limited("trajectory on " + channel + " rejected: " + std::string(to_string(check.reason)) + " (" +
-                      check.detail + "); the active one stays");
+    warn_rate_limited(trajectory_warn_limit_, "trajectory on " + channel +
+                                                  " rejected: " + std::string(to_string(check.reason)) + " (" +
+                                                  check.detail + "); the active one stays");
     return;
   }
   ++trajectories_accepted_;
@@ -110,8 +112,8 @@ void Publisher::publish_sweep(const Sweep& s) {
     if (latency_minute_ms_.size() < latency_minute_ms_.capacity()) latency_minute_ms_.push_back(latency_ms);
     latency_all_.add(latency_ms);
   } else {
-    warn_rate_limited("sweep " + std::to_string(s.index) + " withheld: no valid pose (" +
-                      std::string(pose::to_string(s.pose_status)) + ")");
+    warn_rate_limited(sweep_warn_limit_, "sweep " + std::to_string(s.index) + " withheld: no valid pose (" +
+                                             pose::describe(s.pose_status, s.pose_measured, s.pose_limit) + ")");
   }
   if (processing_window_ms_.size() < processing_window_ms_.capacity()) {
     processing_window_ms_.push_back(static_cast<double>(s.processing_ns) * 1e-6);

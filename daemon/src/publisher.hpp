@@ -36,7 +36,8 @@ class Publisher {
   void publish_status(const StatusSnapshot& s);
   void log_minute(const StatusSnapshot& s);
   void take_reloads();
-  void warn_rate_limited(const std::string& message);
+  // At most one warning per logging.warning_interval_s per limiter, with the count suppressed.
+  static void warn_rate_limited(log::RateLimited& limit, const std::string& message);
   template <typename Message>
   void send(const std::string& channel, const Message& m);
 
@@ -57,7 +58,8 @@ class Publisher {
   StatusSnapshot minute_start_;  // the status at the start of the current minute
   StatusSnapshot last_status_;
   std::int64_t start_steady_ns_;
-  log::RateLimited warn_limit_;
+  log::RateLimited sweep_warn_limit_;       // withheld sweeps
+  log::RateLimited trajectory_warn_limit_;  // rejected trajectory messages: never hidden by the above
 };
 
 }  // namespace trajroi::daemon

@@ -3,17 +3,11 @@
 #include <pthread.h>
 
 #include "pipeline.hpp"
-#include "trajroi/config/text_file.hpp"
 
 namespace trajroi::daemon {
 
-std::unique_ptr<ActiveTrajectory> load_trajectory(const std::filesystem::path& file) {
-  return std::make_unique<ActiveTrajectory>(
-      ActiveTrajectory{roi::parse_trajectory_csv(config::read_text_file(file), file.string()), 0});
-}
-
-Reloader::Reloader(std::filesystem::path file, const EventFd& done)
-    : file_(std::move(file)), done_(done), thread_([this] { run(); }) {}
+Reloader::Reloader(TrajectorySource source, const EventFd& done)
+    : source_(std::move(source)), done_(done), thread_([this] { run(); }) {}
 
 Reloader::~Reloader() {
   {
@@ -49,7 +43,7 @@ void Reloader::run() {
     lock.unlock();
     Result r;
     try {
-      r.trajectory = load_trajectory(file_);
+      r.trajectory = load_trajectory(source_);
     } catch (const std::exception& e) {
       r.error = e.what();
     }

@@ -13,14 +13,11 @@
 #include <vector>
 
 #include "trajroi/daemon/sweep_processor.hpp"
+#include "trajroi/daemon/trajectory_file.hpp"
 
 namespace trajroi::daemon {
 
 class EventFd;
-
-// The configured trajectory file, read and checked. Throws (config::ConfigError or
-// std::runtime_error) naming the file and the line.
-[[nodiscard]] std::unique_ptr<ActiveTrajectory> load_trajectory(const std::filesystem::path& file);
 
 class Reloader {
  public:
@@ -29,7 +26,7 @@ class Reloader {
     std::string error;
   };
   // Starts the thread; `done` is notified when a result is ready.
-  Reloader(std::filesystem::path file, const EventFd& done);
+  Reloader(TrajectorySource source, const EventFd& done);
   ~Reloader();  // stops and joins the thread
   Reloader(const Reloader&) = delete;
   Reloader& operator=(const Reloader&) = delete;
@@ -37,11 +34,11 @@ class Reloader {
   void request();
   // The results ready (the mutex is held for a vector swap only).
   [[nodiscard]] std::vector<Result> take();
-  [[nodiscard]] const std::filesystem::path& file() const noexcept { return file_; }
+  [[nodiscard]] const std::filesystem::path& file() const noexcept { return source_.file; }
 
  private:
   void run();
-  std::filesystem::path file_;
+  TrajectorySource source_;
   const EventFd& done_;
   std::mutex mutex_;
   std::condition_variable cv_;

@@ -1,5 +1,6 @@
 #include "status.hpp"
 
+#include <algorithm>
 #include <string>
 
 #include "pipeline.hpp"
@@ -38,6 +39,7 @@ struct Names {
     set(C::kLidarLateDropped, "lidar.late_dropped");
     set(C::kLidarDuplicates, "lidar.duplicates");
     set(C::kLidarClockResets, "lidar.clock_resets");
+    set(C::kLidarClockJumps, "lidar.clock_jumps");
     set(C::kLidarNoReturn, "lidar.no_return");
     set(C::kLidarOutOfRange, "lidar.out_of_range");
     set(C::kLidarPartialSweeps, "lidar.partial_sweeps");
@@ -89,7 +91,7 @@ std::uint64_t StatusSnapshot::ring_drops() const noexcept {
   return drops;
 }
 
-void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64_t last_lidar_receive_ns, bool final,
+void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64_t last_receive_ns, bool final,
                    StatusSnapshot& s) {
   const vlp16::StreamCounters& l = p.lidar_counters();
   s.steady_ns = steady_ns();
@@ -104,7 +106,9 @@ void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64
   s.pose_valid = current.pose_status == pose::PoseStatus::kValid;
   s.pose_status = current.pose_status;
   const pose::GnssFix* fix = p.poses().newest_fix();
-  s.pose_age_s = fix != nullptr ? static_cast<double>(last_lidar_receive_ns - fix->t_ns) * 1e-9 : -1.0;
+  // Against the newest input's receive time (a replay's clock, not the wall's); a fix stamped
+  // after it (the delay configured too small) is not older than the input: age 0.
+  s.pose_age_s = fix != nullptr ? std::max(0.0, static_cast<double>(last_receive_ns - fix->t_ns) * 1e-9) : -1.0;
   s.fix_type = fix != nullptr ? fix->quality.fix_type : 0;
   s.h_acc_m = fix != nullptr ? fix->quality.h_acc_m : 0.0;
 
@@ -133,6 +137,7 @@ void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64
   s[C::kLidarLateDropped] = l.late_dropped;
   s[C::kLidarDuplicates] = l.duplicates;
   s[C::kLidarClockResets] = l.clock_resets;
+  s[C::kLidarClockJumps] = l.clock_jumps;
   s[C::kLidarNoReturn] = l.no_return;
   s[C::kLidarOutOfRange] = l.out_of_range;
   s[C::kLidarPartialSweeps] = l.partial_frames;

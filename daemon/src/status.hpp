@@ -35,6 +35,7 @@ enum class Counter : std::uint16_t {
   kLidarLateDropped,
   kLidarDuplicates,
   kLidarClockResets,
+  kLidarClockJumps,
   kLidarNoReturn,
   kLidarOutOfRange,
   kLidarPartialSweeps,
@@ -90,7 +91,7 @@ struct StatusSnapshot {
 };
 
 // Fills `s` from the processor (processing thread) and the pipeline's rings and inputs.
-void fill_snapshot(const SweepProcessor& processor, const Pipeline& pipeline, std::int64_t last_lidar_receive_ns,
-                   bool final, StatusSnapshot& s);
+void fill_snapshot(const SweepProcessor& processor, const Pipeline& pipeline, std::int64_t last_receive_ns, bool final,
+                   StatusSnapshot& s);
 
 }  // namespace trajroi::daemon

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 
 #include "trajroi/config/text_file.hpp"
@@ -46,6 +47,11 @@ pose_input::PoseInputConfig pose_input_config(const DaemonConfig& c) {
   p.imu.magnetic_declination_deg = c.magnetic_declination_deg;
   p.gnss_delay_ns = std::llround(c.gnss.delay_s * 1e9);
   p.imu_delay_ns = std::llround(c.imu.delay_s * 1e9);
+  p.attitude = c.pose_source == PoseSource::kGnss ? pose_input::AttitudeFrom::kGnss : pose_input::AttitudeFrom::kImu;
+  p.heading.min_speed_mps = c.gnss_heading.min_speed_mps;
+  p.heading.max_heading_acc_deg = c.gnss_heading.max_heading_acc_deg;
+  p.heading.baseline_yaw_in_robot_rad = c.gnss_heading.baseline_yaw_deg * std::numbers::pi / 180.0;
+  p.initial_heading_deg = c.gnss_heading.initial_heading_deg;
   return p;
 }
 
@@ -108,6 +114,7 @@ SweepProcessor::SweepProcessor(const DaemonConfig& config, std::unique_ptr<Activ
       rects_(config.roi.rect_height_m, config.roi.rect_width_m, {},
              roi::ZLimits{config.roi.z_min_m, config.roi.z_max_m}) {
   if (!active_) throw std::invalid_argument("SweepProcessor: no trajectory");
+  if (config_.pose_source == PoseSource::kFixed) poses_.hold(config_.fixed_pose);
   // Preallocate and touch: the largest chain the look-ahead can need, its grid, the sweep.
   const DaemonConfig::Roi& r = config_.roi;
   const double longest = r.look_ahead_m + r.max_speed_mps * r.look_ahead_per_mps_s;
@@ -179,6 +186,8 @@ void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
 
   const pose::PoseQuery q = poses_.pose_at(frame.start_time_ns);
   s.pose_status = q.status;
+  s.pose_measured = q.measured;
+  s.pose_limit = q.limit;
   s.filtered = q.valid();
   if (!s.filtered) {
     have_hint_ = false;
@@ -257,6 +266,8 @@ void SweepProcessor::add_points(const vlp16::Frame& frame, std::size_t first, Sw
     if (pose == nullptr) {
       sweep_.filtered = false;
       sweep_.pose_status = status;
+      sweep_.pose_measured = firing_.measured();
+      sweep_.pose_limit = firing_.limit();
       sweep_.clear_points();
       have_hint_ = false;
       return;

@@ -40,6 +40,7 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
   udp.position_port = config.lidar.position_port;
   udp.receive_buffer_bytes = config.lidar.receive_buffer_bytes;
   udp.sensor_address = config.lidar.sensor_address;
+  udp.share_ports = config.lidar.share_ports;
   auto lidar = std::make_unique<inputs::UdpInput>(udp);
   pipeline.add_input(std::move(lidar), config.buffers.lidar_packets, "trajroid-lidar", config.realtime.lidar);
   const auto add_serial = [&](const DaemonConfig::Serial& s, const char* name, inputs::Stream stream,
@@ -94,7 +95,7 @@ int run_pipeline(Pipeline& pipeline, SweepProcessor& processor, Outlet& outlet, 
                  bool signals) {
   const std::int64_t start_ns = steady_ns();
   const int sfd = signals ? block_signals() : -1;
-  Reloader reloader(pipeline.config.trajectory_file, pipeline.publish_wake);
+  Reloader reloader(TrajectorySource::from(pipeline.config), pipeline.publish_wake);
   Publisher publisher(pipeline, outlet, &reloader, options.replay.has_value());
   ProcessingOptions processing;
   processing.stall_after_s = options.stall_processing_after_s;

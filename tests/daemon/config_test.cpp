@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "daemon_fixture.hpp"
 
@@ -40,9 +42,11 @@ TEST(DaemonConfig, TheDocumentedExampleReadsWithItsValues) {
   EXPECT_DOUBLE_EQ(c.origin.lat_deg, 36.3721);
   EXPECT_EQ(c.trajectory_file, fs::path(TRAJROI_EXAMPLE_CONFIG).parent_path() / "trajectory.csv");
   EXPECT_EQ(c.lidar.data_port, 2368);
-  EXPECT_DOUBLE_EQ(c.lidar.robot_from_lidar.translation().z(), 0.7);
+  EXPECT_DOUBLE_EQ(c.lidar.robot_from_lidar.translation().z(), 0.0);
   EXPECT_EQ(c.pose_mode, PoseMode::kPerFiring);
-  EXPECT_EQ(c.gate.max_extrapolation_ns, 250'000'000);
+  EXPECT_EQ(c.pose_source, PoseSource::kGnssImu);
+  EXPECT_EQ(c.gate.max_extrapolation_ns, 500'000'000);
+  EXPECT_DOUBLE_EQ(c.gate.max_h_acc_m, 5.0);
   EXPECT_EQ(c.roi.shape, RoiShape::kCircular);
   EXPECT_DOUBLE_EQ(c.roi.spacing_ratio, 0.25);
   EXPECT_EQ(c.lcm.url, "udpm://239.255.76.67:7667?ttl=0");
@@ -63,7 +67,7 @@ TEST(DaemonConfig, MistakesAreNamedByFileLineKeyAndValue) {
                 .find("lidar.data_port: must be a UDP port"),
             std::string::npos);
   EXPECT_NE(
-      error_of(replaced(example(), "  max_h_acc_m: 0.5", "  max_h_acc_m: -1")).find("pose.max_h_acc_m: must be > 0"),
+      error_of(replaced(example(), "  max_h_acc_m: 5.0", "  max_h_acc_m: -1")).find("pose.max_h_acc_m: must be > 0"),
       std::string::npos);
   EXPECT_NE(error_of(replaced(example(), "    lidar: {policy: other}", "    lidar: {policy: fifo, priority: 120}"))
                 .find("realtime.threads.lidar.priority"),
@@ -72,6 +76,72 @@ TEST(DaemonConfig, MistakesAreNamedByFileLineKeyAndValue) {
       error_of(replaced(example(), "  spacing_ratio: 0.25", "  spacing_ratio: 0.000001")).find("roi.spacing_ratio"),
       std::string::npos);
   EXPECT_NE(error_of(replaced(example(), "global_frame:", "global_fram:")).find("global_frame"), std::string::npos);
+}
+
+// The documented defaults are the code's: the example (every key, "with the value the daemon
+// uses when the key is left out") reads exactly as a file holding only the required keys.
+TEST(DaemonConfig, EveryDocumentedDefaultIsTheCodesDefault) {
+  const DaemonConfig documented = parse_daemon_config(example(), fs::path(TRAJROI_EXAMPLE_CONFIG));
+  const DaemonConfig omitted = parse_daemon_config(
+      "global_frame:\n  origin: {lat_deg: 36.3721, lon_deg: 127.3604, height_m: 60.0}\n"
+      "trajectory:\n  file: trajectory.csv\n",
+      fs::path(TRAJROI_EXAMPLE_CONFIG));
+  const std::string a = describe(documented);
+  const std::string b = describe(omitted);
+  EXPECT_EQ(a, b);
+  // And describe() covers every key the file documents (so the comparison above is whole):
+  // each "key:" line of the file, as its dotted path, is one of describe()'s keys.
+  std::istringstream lines(example());
+  std::vector<std::pair<std::size_t, std::string>> path;  // indent, key
+  std::string line;
+  std::size_t keys = 0;
+  while (std::getline(lines, line)) {
+    const std::size_t indent = line.find_first_not_of(' ');
+    if (indent == std::string::npos || line[indent] == '#') continue;
+    const std::size_t colon = line.find(':', indent);
+    ASSERT_NE(colon, std::string::npos) << line;
+    const std::string key = line.substr(indent, colon - indent);
+    while (!path.empty() && path.back().first >= indent)
+      path.pop_back();
+    std::string dotted;
+    for (const auto& [unused, parent] : path)
+      dotted += parent + ".";
+    dotted += key;
+    std::string value = line.substr(colon + 1);
+    value = value.substr(0, value.find('#'));
+    if (value.find_first_not_of(' ') == std::string::npos) {
+      path.emplace_back(indent, key);  // a section
+      continue;
+    }
+    ++keys;
+    EXPECT_NE(("\n" + a).find("\n" + dotted + ": "), std::string::npos) << dotted << " is documented but not described";
+  }
+  EXPECT_GT(keys, 60u);
+}
+
+TEST(DaemonConfig, ValuesThatWouldFailAtRunTimeAreRefusedAtStart) {
+  const auto refused = [](const std::string& from, const std::string& to, const std::string& expected) {
+    const std::string e = error_of(replaced(example(), from, to));
+    EXPECT_NE(e.find(expected), std::string::npos) << to << " → " << e;
+  };
+  refused("  baud: 115200\n  antenna", "  baud: 123457\n  antenna", "gnss.baud: must be one of 1200, 2400");
+  refused("  url: udpm://239.255.76.67:7667?ttl=0", "  url: udpm://239.255.76.67:99999?ttl=0",
+          "port '99999' is not a UDP port");
+  refused("  url: udpm://239.255.76.67:7667?ttl=0", "  url: udpm://10.0.0.1:7667", "not a multicast address");
+  refused("  url: udpm://239.255.76.67:7667?ttl=0", "  url: udp://239.255.76.67:7667", "provider 'udp'");
+  refused("  url: udpm://239.255.76.67:7667?ttl=0", "  url: udpm://239.255.76.67:7667?ttl=300", "ttl '300'");
+  // A device that exists but is no serial port; one that does not exist yet is fine (a USB
+  // receiver may appear after the start).
+  refused("  device: \"\"                     # e.g. /dev/ttyACM0", "  device: /etc/hostname  # e.g. /dev/ttyACM0",
+          "gnss.device: exists but is not a character device");
+  EXPECT_EQ(error_of(replaced(example(), "  device: \"\"                     # e.g. /dev/ttyACM0",
+                              "  device: /dev/ttyTRAJROI_NOT_YET  # e.g. /dev/ttyACM0")),
+            "");
+  EXPECT_EQ(error_of(replaced(example(), "  device: \"\"                     # e.g. /dev/ttyACM0",
+                              "  device: /dev/null  # e.g. /dev/ttyACM0")),
+            "");
+  refused("  initial_heading_deg: none", "  initial_heading_deg: 400", "initial_heading_deg");
+  refused("  source: gnss_imu", "  source: compass", "pose.source");
 }
 
 struct DaemonRun {
@@ -119,6 +189,26 @@ TEST(DaemonConfig, TheDaemonExitsWith78OnABadConfigurationAndCheckConfigPassesAG
   EXPECT_EQ(not_yaml.code, 78) << not_yaml.err;
   EXPECT_EQ(trajroid(dir / "absent.yaml").code, 78);
   EXPECT_EQ(trajroid(TRAJROI_EXAMPLE_CONFIG, "--check-config --rate sideways").code, 78);
+  const DaemonRun bad_url = trajroid(TRAJROI_EXAMPLE_CONFIG, "--check-config --lcm-url udpm://239.255.76.67:99999");
+  EXPECT_EQ(bad_url.code, 78);
+  EXPECT_NE(bad_url.err.find("99999"), std::string::npos) << bad_url.err;
+  const DaemonRun bad_baud =
+      trajroid(write("bad_baud.yaml", replaced(example(), "  baud: 115200\n  antenna", "  baud: 123457\n  antenna")),
+               "--check-config");
+  EXPECT_EQ(bad_baud.code, 78);
+  EXPECT_NE(bad_baud.err.find("gnss.baud"), std::string::npos) << bad_baud.err;
+  EXPECT_NE(bad_baud.err.find("123457"), std::string::npos) << bad_baud.err;
+  // Degrees read as metres: refused; the same file declared as lat,lon: accepted.
+  std::ofstream(dir / "degrees.csv") << "36.3721,127.3604\n36.3731,127.3614\n";
+  const DaemonRun degrees = trajroid(
+      write("degrees.yaml", replaced(example(), "file: trajectory.csv", "file: degrees.csv")), "--check-config");
+  EXPECT_EQ(degrees.code, 78);
+  EXPECT_NE(degrees.err.find("look like degrees"), std::string::npos) << degrees.err;
+  std::ofstream(dir / "lat_lon.csv") << "lat,lon\n36.3721,127.3604\n36.3731,127.3614\n";
+  EXPECT_EQ(trajroid(write("lat_lon.yaml", replaced(example(), "file: trajectory.csv", "file: lat_lon.csv")),
+                     "--check-config")
+                .code,
+            0);
   fs::remove_all(dir);
 }
 

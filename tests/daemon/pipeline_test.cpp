@@ -122,7 +122,7 @@ std::map<std::int64_t, std::size_t> reference_kept(const DaemonConfig& config) {
       if (s.filtered) kept[static_cast<std::int64_t>(s.index)] = s.size();
     }
   } sink;
-  SweepProcessor processor(config, trajroi::daemon::load_trajectory(config.trajectory_file));
+  SweepProcessor processor(config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
   for (const Item& i : run_items({})) {
     switch (i.stream) {
       case inputs::Stream::kGnss:
@@ -152,7 +152,7 @@ TEST(Pipeline, ThreeFakeInputLanesThroughTheThreadsGiveTheProcessorsOwnSweeps) {
   pipeline.add_input(std::make_unique<FakeInput>(run_items({true, false, false}), kRate), 64, "test-lidar", {});
   pipeline.add_input(std::make_unique<FakeInput>(run_items({false, true, false}), kRate), 64, "test-gnss", {});
   pipeline.add_input(std::make_unique<FakeInput>(run_items({false, false, true}), kRate), 64, "test-imu", {});
-  SweepProcessor processor(config, trajroi::daemon::load_trajectory(config.trajectory_file));
+  SweepProcessor processor(config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
   FakeOutlet outlet;
   trajroi::daemon::RunOptions options;
   options.replay = corridor_run();  // said in the status message only
@@ -193,7 +193,7 @@ TEST(Pipeline, OneRecordedLaneIsExactlyTheProcessorsOutput) {
   const DaemonConfig config = trajroi::daemon::load_daemon_config(corridor_run() / "trajroid.yaml");
   Pipeline pipeline(config, /*exact=*/true, /*record=*/false);
   pipeline.add_input(std::make_unique<FakeInput>(run_items({})), 16, "test-replay", {});
-  SweepProcessor processor(config, trajroi::daemon::load_trajectory(config.trajectory_file));
+  SweepProcessor processor(config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
   FakeOutlet outlet;
   EXPECT_EQ(trajroi::daemon::run_pipeline(pipeline, processor, outlet, {}, /*signals=*/false), 0);
   std::map<std::int64_t, std::size_t> published;
@@ -213,7 +213,8 @@ TEST(Pipeline, TheEvaluationKeepsExactlyWhatTheDaemonPublishes) {
   Pipeline pipeline(daemon_config, /*exact=*/true, /*record=*/false);
   pipeline.add_input(std::make_unique<inputs::RecordedInput>(corridor_run(), inputs::RecordedOptions{}),
                      daemon_config.buffers.lidar_packets, "test-replay", {});
-  SweepProcessor processor(daemon_config, trajroi::daemon::load_trajectory(daemon_config.trajectory_file));
+  SweepProcessor processor(daemon_config,
+                           trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(daemon_config)));
   FakeOutlet outlet;
   ASSERT_EQ(trajroi::daemon::run_pipeline(pipeline, processor, outlet, {}, /*signals=*/false), 0);
   std::map<std::int64_t, trajroi::points_t> published;

@@ -73,7 +73,18 @@ SerialInput::Next SerialInput::next(InputItem& item, std::chrono::milliseconds t
     have_pending_ = false;  // the bytes of the read that opened the port, after its notice
   } else {
     status = port_->read(pending_, timeout);
+    // A device that cannot be opened (missing, not permitted) is said at once, and again
+    // whenever the reason changes; the port keeps retrying (a USB receiver may appear later).
+    if (port_->counters().open_failures != open_failures_) {
+      open_failures_ = port_->counters().open_failures;
+      if (port_->last_error() != reported_error_) {
+        reported_error_ = port_->last_error();
+        notice_ = {Notice::Level::kWarning, name_ + ": cannot open " + reported_error_ + "; retrying until it appears"};
+        return Next::kNotice;
+      }
+    }
     if (port_->counters().opens != opens_) {
+      reported_error_.clear();
       opens_ = port_->counters().opens;
       notice_ = {Notice::Level::kInfo,
                  name_ + ": " + port_->describe() + " open (" +

@@ -139,12 +139,25 @@ class SerialPortSource::TermiosPort final : public Port {
   int fd_ = -1;
 };
 
+bool is_supported_baud(int baud) noexcept {
+  return std::any_of(kBauds.begin(), kBauds.end(), [baud](const BaudRate& b) { return b.baud == baud; });
+}
+
+std::string supported_bauds_text() {
+  std::string text;
+  for (const BaudRate& b : kBauds) {
+    if (!text.empty()) text.append(", ");
+    text.append(std::to_string(b.baud));
+  }
+  return text;
+}
+
 SerialPortSource::SerialPortSource(SerialPortOptions options)
     : options_(std::move(options)), buffer_(options_.read_buffer_bytes), backoff_(options_.min_backoff) {
   if (options_.device.empty()) throw std::invalid_argument("serial port: no device configured");
-  if (std::none_of(kBauds.begin(), kBauds.end(), [&](const BaudRate& b) { return b.baud == options_.baud; })) {
+  if (!is_supported_baud(options_.baud)) {
     throw std::invalid_argument("serial port " + options_.device + ": baud rate " + std::to_string(options_.baud) +
-                                " is not one of 1200 … 921600");
+                                " is not one of " + supported_bauds_text());
   }
   if (options_.read_buffer_bytes == 0 || options_.min_backoff.count() <= 0 ||
       options_.max_backoff < options_.min_backoff) {
@@ -171,10 +184,18 @@ bool SerialPortSource::try_open() {
   std::string error;
   auto sp = std::make_unique<LibserialportPort>();
   bool describable = false;
-  error = sp->open(options_, describable);
+  // A device that is not there, or not ours to open, says so with its errno (libserialport's
+  // own message for these is vaguer).
+  if (::access(options_.device.c_str(), R_OK | W_OK) != 0) {
+    const int e = errno;
+    error = std::string(std::strerror(e)) + " (errno " + std::to_string(e) + ")";
+  } else {
+    error = sp->open(options_, describable);
+  }
   if (error.empty()) {
     port_ = std::move(sp);
-  } else if (!describable && std::filesystem::exists(options_.device)) {
+  } else if (!describable && std::filesystem::exists(options_.device) &&
+             ::access(options_.device.c_str(), R_OK | W_OK) == 0) {
     // A node libserialport does not know (a pseudo-terminal): termios.
     auto tty = std::make_unique<TermiosPort>();
     error = tty->open(options_);

@@ -134,7 +134,11 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
       return;
     }
     const auto delta = static_cast<double>(delta_us);
-    if (delta > kLossFactor * period_us) {
+    const double host_elapsed_us = static_cast<double>(receive_time_ns - last_receive_ns_) / 1000.0;
+    if (delta > 2.0 * host_elapsed_us + static_cast<double>(kClockResetThreshold_ns) / 1000.0) {
+      ++counters_.clock_jumps;
+      if (host_elapsed_us > kLossFactor * period_us) lost = missing(host_elapsed_us, period_us);
+    } else if (delta > kLossFactor * period_us) {
       lost = missing(delta, period_us);
     } else if (rate_cdeg_per_us_ > 0.0) {
       const double expected_cdeg = rate_cdeg_per_us_ * delta;
@@ -166,6 +170,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   }
   have_last_ = true;
   last_toh_us_ = toh;
+  last_receive_ns_ = receive_time_ns;
   last_first_azimuth_ = first_azimuth;
   const std::size_t last_firing_block = kBlocks - step;
   const std::uint32_t span_cdeg = azimuth_gap(first_azimuth, block_azimuth(packet, last_firing_block));

@@ -58,8 +58,9 @@ void UdpSource::open_socket(Socket& socket, std::uint16_t port, bool data) {
   socket.fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
   if (socket.fd < 0) throw std::runtime_error("UDP " + where + ": socket: " + std::strerror(errno));
   const int on = 1;
-  // Several readers (a recorder beside the daemon) may share the port.
-  setsockopt(socket.fd, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
+  if (options_.share_ports && setsockopt(socket.fd, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on) != 0) {
+    throw std::runtime_error("UDP " + where + ": SO_REUSEADDR: " + std::strerror(errno));
+  }
   if (setsockopt(socket.fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on) != 0) {
     throw std::runtime_error("UDP " + where + ": SO_TIMESTAMPNS: " + std::strerror(errno));
   }
@@ -77,10 +78,15 @@ void UdpSource::open_socket(Socket& socket, std::uint16_t port, bool data) {
     getsockopt(socket.fd, SOL_SOCKET, SO_RCVBUF, &granted_, &length);
   }
   if (::bind(socket.fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
+    const bool errno_in_use = errno == EADDRINUSE;
     const std::string reason = std::strerror(errno);
     ::close(socket.fd);
     socket.fd = -1;
-    throw std::runtime_error("UDP " + where + ": bind: " + reason);
+    const bool in_use = errno_in_use;
+    throw std::runtime_error("UDP " + where + ": bind: " + reason +
+                             (in_use ? " (another process receives on this port; lidar.share_ports: true lets "
+                                       "several readers share it)"
+                                     : ""));
   }
   sockaddr_in bound{};
   socklen_t bound_length = sizeof bound;

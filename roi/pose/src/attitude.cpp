@@ -25,15 +25,22 @@ const Eigen::Quaterniond& frd_from_flu() {
 
 }  // namespace
 
-Eigen::Quaterniond enu_from_vn_ypr(double yaw_deg, double pitch_deg, double roll_deg, const ImuMounting& mounting) {
+Eigen::Quaterniond ned_from_frd_ypr(double yaw_deg, double pitch_deg, double roll_deg) {
   // 3-2-1 intrinsic: yaw about down, then pitch about the new y (right), then roll about x.
-  const Eigen::Quaterniond ned_from_frd = about(Eigen::Vector3d::UnitZ(), yaw_deg * kDegToRad) *
-                                          about(Eigen::Vector3d::UnitY(), pitch_deg * kDegToRad) *
-                                          about(Eigen::Vector3d::UnitX(), roll_deg * kDegToRad);
+  return about(Eigen::Vector3d::UnitZ(), yaw_deg * kDegToRad) * about(Eigen::Vector3d::UnitY(), pitch_deg * kDegToRad) *
+         about(Eigen::Vector3d::UnitX(), roll_deg * kDegToRad);
+}
+
+Eigen::Quaterniond enu_from_vn_ypr(double yaw_deg, double pitch_deg, double roll_deg, const ImuMounting& mounting) {
+  return enu_from_vn_rotation(ned_from_frd_ypr(yaw_deg, pitch_deg, roll_deg), mounting);
+}
+
+Eigen::Quaterniond enu_from_vn_rotation(const Eigen::Quaterniond& ned_from_frd, const ImuMounting& mounting) {
   // Declination turns the magnetic NED frame into the true one: a rotation about down.
   const Eigen::Quaterniond true_from_magnetic =
       about(Eigen::Vector3d::UnitZ(), mounting.magnetic_declination_deg * kDegToRad);
-  const Eigen::Quaterniond enu_from_imu = enu_from_ned() * true_from_magnetic * ned_from_frd * frd_from_flu();
+  const Eigen::Quaterniond enu_from_imu =
+      enu_from_ned() * true_from_magnetic * ned_from_frd.normalized() * frd_from_flu();
   return (enu_from_imu * mounting.robot_from_imu.conjugate()).normalized();
 }
 

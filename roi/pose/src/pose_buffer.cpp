@@ -1,6 +1,7 @@
 #include "trajroi/pose/pose_buffer.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace trajroi::pose {
@@ -33,6 +34,33 @@ std::string_view to_string(PoseStatus status) noexcept {
       return "GNSS carrier solution not fixed (RTK fixed required)";
   }
   return "unknown";
+}
+
+std::string describe(PoseStatus status, double measured, double limit) {
+  char text[160];
+  switch (status) {
+    case PoseStatus::kFixTypeTooLow:
+      std::snprintf(text, sizeof text, "GNSS fix type %.0f < minimum %.0f (pose.min_fix_type)", measured, limit);
+      return text;
+    case PoseStatus::kAccuracyTooLow:
+      std::snprintf(text, sizeof text, "GNSS horizontal accuracy %.2f m > limit %.2f m (pose.max_h_acc_m)", measured,
+                    limit);
+      return text;
+    case PoseStatus::kGnssTooOld:
+    case PoseStatus::kAttitudeTooOld:
+      std::snprintf(text, sizeof text, "%s: %.3f s > %.3f s (pose.max_extrapolation_s)",
+                    status == PoseStatus::kGnssTooOld ? "newest GNSS fix too old" : "newest attitude too old", measured,
+                    limit);
+      return text;
+    case PoseStatus::kGnssGap:
+    case PoseStatus::kAttitudeGap:
+      std::snprintf(text, sizeof text, "%s %.3f s > %.3f s (pose.max_gap_s)",
+                    status == PoseStatus::kGnssGap ? "gap between GNSS fixes" : "gap between attitudes", measured,
+                    limit);
+      return text;
+    default:
+      return std::string(to_string(status));
+  }
 }
 
 template <class T>
@@ -103,16 +131,35 @@ bool PoseBuffer::add_attitude(const AttitudeSample& a) noexcept {
   return true;
 }
 
-PoseStatus PoseBuffer::check(const FixQuality& q) const noexcept {
-  if (q.fix_type < gate_.min_fix_type || q.fix_type == 5) return PoseStatus::kFixTypeTooLow;  // 5: time only
+PoseStatus PoseBuffer::check(const FixQuality& q, PoseQuery& out) const noexcept {
+  const auto fail = [&out](PoseStatus s, double measured, double limit) {
+    out.measured = measured;
+    out.limit = limit;
+    return s;
+  };
+  if (q.fix_type < gate_.min_fix_type || q.fix_type == 5) {  // 5: time only
+    return fail(PoseStatus::kFixTypeTooLow, q.fix_type, gate_.min_fix_type);
+  }
   if (gate_.require_gnss_fix_ok && !q.gnss_fix_ok) return PoseStatus::kNoGnssFixOk;
-  if (!(q.h_acc_m <= gate_.max_h_acc_m)) return PoseStatus::kAccuracyTooLow;
+  if (!(q.h_acc_m <= gate_.max_h_acc_m)) return fail(PoseStatus::kAccuracyTooLow, q.h_acc_m, gate_.max_h_acc_m);
   if (gate_.require_rtk_fixed && !q.rtk_fixed) return PoseStatus::kNotRtkFixed;
   return PoseStatus::kValid;
 }
 
 PoseQuery PoseBuffer::pose_at(std::int64_t t_ns) const noexcept {
   PoseQuery out;
+  if (held_) {
+    out.status = PoseStatus::kValid;
+    out.global_from_robot = *held_;
+    return out;
+  }
+  constexpr double kNsToS = 1e-9;
+  const auto fail = [&out](PoseStatus s, std::int64_t measured_ns, std::int64_t limit_ns) {
+    out.status = s;
+    out.measured = static_cast<double>(measured_ns) * kNsToS;
+    out.limit = static_cast<double>(limit_ns) * kNsToS;
+    return out;
+  };
   if (fixes_.size == 0) {
     out.status = PoseStatus::kNoGnss;
     return out;
@@ -130,17 +177,14 @@ PoseQuery PoseBuffer::pose_at(std::int64_t t_ns) const noexcept {
     return out;
   }
   const GnssFix& a = fixes_.at(f);
-  if (PoseStatus s = check(a.quality); s != PoseStatus::kValid) {
+  if (PoseStatus s = check(a.quality, out); s != PoseStatus::kValid) {
     out.status = s;
     return out;
   }
   if (f + 1 < fixes_.size) {
     const GnssFix& b = fixes_.at(f + 1);
-    if (b.t_ns - a.t_ns > gate_.max_gap_ns) {
-      out.status = PoseStatus::kGnssGap;
-      return out;
-    }
-    if (PoseStatus s = check(b.quality); s != PoseStatus::kValid) {
+    if (b.t_ns - a.t_ns > gate_.max_gap_ns) return fail(PoseStatus::kGnssGap, b.t_ns - a.t_ns, gate_.max_gap_ns);
+    if (PoseStatus s = check(b.quality, out); s != PoseStatus::kValid) {
       out.status = s;
       return out;
     }
@@ -148,15 +192,13 @@ PoseQuery PoseBuffer::pose_at(std::int64_t t_ns) const noexcept {
     antenna = a.antenna_global_m + w * (b.antenna_global_m - a.antenna_global_m);
   } else {
     const std::int64_t ahead = t_ns - a.t_ns;
-    if (ahead > gate_.max_extrapolation_ns) {
-      out.status = PoseStatus::kGnssTooOld;
-      return out;
-    }
+    if (ahead > gate_.max_extrapolation_ns) return fail(PoseStatus::kGnssTooOld, ahead, gate_.max_extrapolation_ns);
     antenna = a.antenna_global_m;
     // Linear extrapolation from the last two fixes when they are close enough and both pass.
     if (f > 0 && ahead > 0) {
       const GnssFix& prev = fixes_.at(f - 1);
-      if (a.t_ns - prev.t_ns <= gate_.max_gap_ns && check(prev.quality) == PoseStatus::kValid) {
+      PoseQuery ignored;
+      if (a.t_ns - prev.t_ns <= gate_.max_gap_ns && check(prev.quality, ignored) == PoseStatus::kValid) {
         const Eigen::Vector3d velocity =
             (a.antenna_global_m - prev.antenna_global_m) / static_cast<double>(a.t_ns - prev.t_ns);
         antenna += velocity * static_cast<double>(ahead);
@@ -175,15 +217,13 @@ PoseQuery PoseBuffer::pose_at(std::int64_t t_ns) const noexcept {
   if (r + 1 < attitudes_.size) {
     const AttitudeSample& qb = attitudes_.at(r + 1);
     if (qb.t_ns - qa.t_ns > gate_.max_gap_ns) {
-      out.status = PoseStatus::kAttitudeGap;
-      return out;
+      return fail(PoseStatus::kAttitudeGap, qb.t_ns - qa.t_ns, gate_.max_gap_ns);
     }
     const double w = static_cast<double>(t_ns - qa.t_ns) / static_cast<double>(qb.t_ns - qa.t_ns);
     attitude = qa.global_from_robot.slerp(w, qb.global_from_robot);
   } else {
     if (t_ns - qa.t_ns > gate_.max_extrapolation_ns) {
-      out.status = PoseStatus::kAttitudeTooOld;
-      return out;
+      return fail(PoseStatus::kAttitudeTooOld, t_ns - qa.t_ns, gate_.max_extrapolation_ns);
     }
     attitude = qa.global_from_robot;  // held within the bound
   }

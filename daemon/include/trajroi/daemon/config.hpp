@@ -24,6 +24,15 @@ inline constexpr int kExitConfig = 78;
 
 using roi::RoiShape;
 enum class PoseMode : std::uint8_t { kPerFiring, kPerSweep };
+enum class TrajectoryCoordinates : std::uint8_t { kGlobalXy, kLatLon };
+
+// Where the robot's pose comes from (pose.source).
+enum class PoseSource : std::uint8_t {
+  kGnssImu,  // u-blox position + VN-100 attitude
+  kGnss,     // u-blox alone: heading from the course over ground or a moving-base baseline
+  kFixed,    // a static pose from the configuration
+};
+[[nodiscard]] std::string_view to_string(PoseSource source) noexcept;
 enum class SchedPolicy : std::uint8_t { kOther, kFifo, kRr };
 
 struct ThreadConfig {
@@ -37,7 +46,8 @@ struct DaemonConfig {
 
   pose::Geodetic origin;
 
-  std::filesystem::path trajectory_file;  // CSV of x,y (global frame, m)
+  std::filesystem::path trajectory_file;  // CSV of x,y (global frame, m) or lat,lon (degrees)
+  TrajectoryCoordinates trajectory_coordinates = TrajectoryCoordinates::kGlobalXy;  // without a header line
 
   struct Lidar {
     std::filesystem::path calibration;  // velodyne/nebula YAML; empty: the manual's values
@@ -50,6 +60,7 @@ struct DaemonConfig {
     std::uint16_t data_port = 2368;
     std::uint16_t position_port = 8308;
     int receive_buffer_bytes = 4 << 20;
+    bool share_ports = false;  // SO_REUSEADDR: other readers may bind the same ports (multicast)
   } lidar;
 
   struct Serial {
@@ -63,8 +74,24 @@ struct DaemonConfig {
   double magnetic_declination_deg = 0.0;
   Eigen::Quaterniond robot_from_imu = Eigen::Quaterniond::Identity();
 
+  PoseSource pose_source = PoseSource::kGnssImu;
+  struct GnssHeading {                          // pose.source gnss
+    double min_speed_mps = 1.0;                 // course over ground trusted above this
+    double max_heading_acc_deg = 5.0;           // … and with headAcc / accHeading at most this
+    double baseline_yaw_deg = 0.0;              // moving-base baseline (reference → rover) in the robot frame
+    std::optional<double> initial_heading_deg;  // true bearing until the GNSS gives one
+  } gnss_heading;
+  Eigen::Isometry3d fixed_pose = Eigen::Isometry3d::Identity();  // pose.source fixed: global_from_robot
   PoseMode pose_mode = PoseMode::kPerFiring;
-  pose::PoseGate gate;
+  // The gate's defaults are what a standalone receiver passes (the u-blox M8/F9 without
+  // corrections report 1–3 m; the data set's receivers 0.98–2.5 m) at its common rates (4 Hz
+  // needs 0.25 s + the delay past the newest fix); tighten them for RTK.
+  pose::PoseGate gate = [] {
+    pose::PoseGate g;
+    g.max_h_acc_m = 5.0;
+    g.max_extrapolation_ns = 500'000'000;
+    return g;
+  }();
   std::size_t pose_capacity = 4096;
 
   struct Roi {
@@ -107,6 +134,15 @@ struct DaemonConfig {
     ThreadConfig lidar, gnss, imu, processing, publisher;
   } realtime;
 };
+
+// Empty when `url` is an LCM URL the daemon can use (provider udpm, memq, file or tcpq; for
+// udpm an IPv4 multicast address, a port 1 … 65535, ttl 0 … 255), else what is wrong with it.
+[[nodiscard]] std::string check_lcm_url(const std::string& url);
+
+// Every effective value, one "section.key: value" line each, in config/trajroid.yaml's order
+// and units (what --check-config prints; a test compares the file's documented defaults with
+// the code's through it).
+[[nodiscard]] std::string describe(const DaemonConfig& config);
 
 // Reads and checks a configuration. Throws config::ConfigError.
 [[nodiscard]] DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::path& file);

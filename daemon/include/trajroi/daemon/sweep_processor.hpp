@@ -65,14 +65,15 @@ struct Sweep {
   // The pose: `filtered` only when it was valid for every point.
   bool filtered = false;
   pose::PoseStatus pose_status = pose::PoseStatus::kNoGnss;
-  std::int64_t pose_t_ns = 0;  // sweep start
-  PublishedPose robot;         // global_from_robot at the start
-  PublishedPose sensor;        // global_from_lidar at the start (used for the whole
-                               // sweep in per-sweep mode)
-  double speed_mps = 0.0;      // over the last 0.5 s (0.2 s, 0.1 s after a pose gap)
-  bool speed_known = false;    // false: the pose valid for less than 0.1 s (speed_mps 0)
-  pose::FixQuality fix;        // newest fix at the sweep's start
-  std::int64_t fix_t_ns = 0;   // its time (0: none)
+  double pose_measured = 0.0, pose_limit = 0.0;  // the failing figure and its limit (PoseQuery)
+  std::int64_t pose_t_ns = 0;                    // sweep start
+  PublishedPose robot;                           // global_from_robot at the start
+  PublishedPose sensor;                          // global_from_lidar at the start (used for the whole
+                                                 // sweep in per-sweep mode)
+  double speed_mps = 0.0;                        // over the last 0.5 s (0.2 s, 0.1 s after a pose gap)
+  bool speed_known = false;                      // false: the pose valid for less than 0.1 s (speed_mps 0)
+  pose::FixQuality fix;                          // newest fix at the sweep's start
+  std::int64_t fix_t_ns = 0;                     // its time (0: none)
 
   // The ROI chain.
   std::int32_t trajectory_id = 0;

@@ -50,9 +50,10 @@ class SerialInput final : public InputSource {
   std::string name_;
   Stream stream_;
   std::unique_ptr<serial::SerialPortSource> port_;
-  std::uint64_t opens_ = 0, items_ = 0;
-  serial::Chunk pending_;      // the last read; its bytes live in the port until the next read
-  bool have_pending_ = false;  // read with the port's opening, handed out after the notice
+  std::uint64_t opens_ = 0, items_ = 0, open_failures_ = 0;
+  std::string reported_error_;  // the open failure last said (said again only when it changes)
+  serial::Chunk pending_;       // the last read; its bytes live in the port until the next read
+  bool have_pending_ = false;   // read with the port's opening, handed out after the notice
   Notice notice_;
 };
 

@@ -4,10 +4,18 @@
 // NAV-HPPOSLLH / NAV-PVT and the VN-100 attitude, places them in the global frame and stamps
 // them in the host clock. Pure: bytes and receive times in, samples into a PoseBuffer out.
 //
-// Time. A sample is stamped with its sensor time (UBX iTOW, VN-100 TimeStartup) mapped onto
-// the host clock by ClockMap — host = sensor + min(receive − sensor) − delay — so serial
-// jitter does not reach the pose; `delay` is the known part of the transport (epoch to the
-// message's receipt) that the minimum cannot see.
+// Time. A sample is stamped with its sensor time (UBX iTOW, VN-100 TimeStartup or TimeGps)
+// mapped onto the host clock by ClockMap — host = sensor + min(receive − sensor) − delay — so
+// serial jitter does not reach the pose; `delay` is the known part of the transport (epoch to
+// the message's receipt) that the minimum cannot see. A VN-100 output without a time field
+// (common: YawPitchRoll alone) is placed at its receive time minus the delay.
+//
+// Attitude. From the IMU (pose.source gnss_imu): the VN-100 output's YawPitchRoll,
+// Quaternion or DCM, whichever it carries (in that order). From the GNSS alone (pose.source
+// gnss): the yaw of a moving-base baseline (NAV-RELPOSNED relPosHeading, valid) of the same
+// epoch, else the course over ground above a speed; roll and pitch zero. Without either the
+// last heading is held; before the first, a configured initial heading, else none (the pose
+// gate then reports no attitude). heading_source() says which is in use.
 //
 // Position. NAV-PVT closes an epoch: its position comes from the NAV-HPPOSLLH of the same
 // iTOW when one came before it (0.1 mm instead of 1 cm), else from NAV-PVT itself; its
@@ -17,6 +25,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string_view>
 
 #include "trajroi/pose/attitude.hpp"
 #include "trajroi/pose/geodetic.hpp"
@@ -44,10 +53,25 @@ class ClockMap {
   std::uint64_t resets_ = 0;
 };
 
+enum class AttitudeFrom : std::uint8_t { kImu, kGnss };
+
+enum class HeadingSource : std::uint8_t {
+  kNone,        // no attitude yet
+  kImu,         // the VN-100's attitude
+  kBaseline,    // NAV-RELPOSNED moving-base heading
+  kCourse,      // NAV-PVT course over ground
+  kHeld,        // the last GNSS heading, held while neither is usable (slow, or no baseline)
+  kConfigured,  // the configured initial heading, before the GNSS gave one
+};
+[[nodiscard]] std::string_view to_string(HeadingSource source) noexcept;
+
 struct PoseInputConfig {
   pose::ImuMounting imu;
   std::int64_t gnss_delay_ns = 0;  // epoch → receipt of its NAV-PVT
   std::int64_t imu_delay_ns = 0;   // sample → receipt of its frame
+  AttitudeFrom attitude = AttitudeFrom::kImu;
+  pose::HeadingFallback heading;              // with AttitudeFrom::kGnss
+  std::optional<double> initial_heading_deg;  // true bearing, until the GNSS gives a heading
 };
 
 struct PoseInputCounters {
@@ -56,7 +80,10 @@ struct PoseInputCounters {
   std::uint64_t invalid_position = 0;  // epochs flagged invalidLlh, or off the WGS-84 range / the frame
   std::uint64_t malformed = 0;         // framed UBX/VN-100 that did not decode
   std::uint64_t attitudes = 0;
-  std::uint64_t imu_without_attitude = 0;  // frames lacking TimeStartup or YawPitchRoll
+  std::uint64_t imu_without_attitude = 0;  // frames carrying no YawPitchRoll, Quaternion or DCM
+  std::uint64_t imu_receive_stamped = 0;   // … with an attitude but no sensor time (placed at receipt)
+  std::uint64_t gnss_headings = 0;         // attitudes made from the GNSS (course, baseline, held)
+  std::uint64_t ubx_other = 0;             // well-formed UBX messages not used (neither PVT nor HPPOSLLH / RELPOSNED)
   std::uint64_t refused = 0;               // samples the buffer refused (order, non-finite)
 };
 
@@ -75,8 +102,12 @@ class PoseInput {
   [[nodiscard]] const framing::FramerCounters& imu_framing() const noexcept { return vn_.counters(); }
   [[nodiscard]] const ClockMap& gnss_clock() const noexcept { return gnss_clock_; }
   [[nodiscard]] const ClockMap& imu_clock() const noexcept { return imu_clock_; }
+  [[nodiscard]] HeadingSource heading_source() const noexcept { return heading_source_; }
 
  private:
+  void gnss_heading(const ublox::NavPvt& pvt, std::int64_t t_ns);
+  bool add_attitude(const Eigen::Quaterniond& global_from_robot, std::int64_t t_ns);
+
   pose::GlobalFrame frame_;
   PoseInputConfig config_;
   pose::PoseBuffer& buffer_;
@@ -85,6 +116,9 @@ class PoseInput {
   ClockMap gnss_clock_;
   ClockMap imu_clock_;
   std::optional<ublox::NavHpposllh> hp_;
+  std::optional<ublox::NavRelposned> relpos_;
+  std::optional<double> heading_yaw_rad_;  // the last GNSS (or configured) heading, global yaw
+  HeadingSource heading_source_ = HeadingSource::kNone;
   std::optional<pose::Geodetic> last_position_;
   std::optional<Eigen::Vector3d> last_global_;  // last_position_ in the global frame
   PoseInputCounters counters_;

@@ -26,6 +26,10 @@ struct SerialPortOptions {
   std::chrono::milliseconds max_backoff{5000};
 };
 
+// The baud rates the port layer offers (1200 … 921600, the POSIX / Linux standard rates).
+[[nodiscard]] bool is_supported_baud(int baud) noexcept;
+[[nodiscard]] std::string supported_bauds_text();
+
 class SerialPortSource final : public ByteSource {
  public:
   // Throws std::invalid_argument for an empty device, a baud rate the kernel does not offer,

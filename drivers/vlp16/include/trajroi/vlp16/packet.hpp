@@ -53,8 +53,11 @@ inline constexpr auto& read_u16 = framing::le_u16;
 inline constexpr auto& read_u32 = framing::le_u32;
 
 // Field accessors; the packet must have been validated (validate_data_packet() == kNone).
+// The firmware writes 36000 for a block that fires exactly at the wrap, before it writes 0:
+// that is 0° (ros-drivers/velodyne and VeloView take the azimuth modulo 36000).
 [[nodiscard]] inline std::uint16_t block_azimuth(std::span<const std::uint8_t> p, std::size_t block) noexcept {
-  return read_u16(p, block * kBlockBytes + 2);
+  const std::uint16_t raw = read_u16(p, block * kBlockBytes + 2);
+  return raw == kAzimuthLimit ? std::uint16_t{0} : raw;
 }
 // Channel 0 … 31 of a block: firing sequence channel / 16, laser channel % 16.
 [[nodiscard]] inline std::uint16_t channel_distance(std::span<const std::uint8_t> p, std::size_t block,

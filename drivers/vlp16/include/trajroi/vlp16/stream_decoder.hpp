@@ -18,6 +18,10 @@
 // duplicate and dropped. A timestamp more than kRestartThreshold_us behind the previous one
 // is no reordering but a sensor that restarted its clock (a power cycle, a replay looping):
 // the frame in progress ends (partial) and the stream starts afresh (counted as a restart).
+// A timestamp step far beyond the host time that passed between the two packets (more than
+// twice it plus kClockResetThreshold_ns) is the sensor's clock jumping forward (a PPS
+// re-sync), not loss: it is counted as a clock jump and only the packets the host time had
+// room for are counted lost.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -84,7 +88,8 @@ struct StreamCounters {
   std::uint64_t late_dropped = 0;  // out of order and older than the current frame
   std::uint64_t duplicates = 0;
   std::uint64_t clock_resets = 0;
-  std::uint64_t restarts = 0;  // sensor time jumped back by more than kRestartThreshold_us
+  std::uint64_t restarts = 0;     // sensor time jumped back by more than kRestartThreshold_us
+  std::uint64_t clock_jumps = 0;  // sensor time jumped forward far beyond the host time elapsed
   std::uint64_t points = 0;
   std::uint64_t no_return = 0;
   std::uint64_t out_of_range = 0;
@@ -144,6 +149,7 @@ class StreamDecoder {
   // Sequence and clock state of the last accepted packet.
   bool have_last_ = false;
   std::uint32_t last_toh_us_ = 0;
+  std::int64_t last_receive_ns_ = 0;
   std::uint16_t last_first_azimuth_ = 0;
   double rate_cdeg_per_us_ = 0.0;  // measured inside the last packet
   std::int64_t anchor_time_ns_ = 0;

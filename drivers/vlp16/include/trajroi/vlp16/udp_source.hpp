@@ -26,6 +26,10 @@ struct UdpOptions {
   // When set (an IPv4 address), datagrams from any other source address are dropped and
   // counted (rejected_sources()); empty accepts every sender.
   std::string sensor_address;
+  // The ports are this process's alone: a second bind to them fails (EADDRINUSE), so two
+  // daemons can never split one sensor's stream between them. `share_ports` (SO_REUSEADDR)
+  // is for multicast set-ups where several readers receive the same datagrams.
+  bool share_ports = false;
 };
 
 class UdpSource final : public PacketSource {

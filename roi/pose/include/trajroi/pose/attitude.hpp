@@ -28,6 +28,14 @@ struct ImuMounting {
 // VN-100 yaw/pitch/roll (degrees, NED/FRD, magnetic) → rotation global(ENU)_from_robot(FLU).
 [[nodiscard]] Eigen::Quaterniond enu_from_vn_ypr(double yaw_deg, double pitch_deg, double roll_deg,
                                                  const ImuMounting& mounting = {});
+// The VN-100's rotation NED_from_FRD for its yaw/pitch/roll: Rz(yaw) Ry(pitch) Rx(roll).
+[[nodiscard]] Eigen::Quaterniond ned_from_frd_ypr(double yaw_deg, double pitch_deg, double roll_deg);
+// enu_from_vn_ypr from the VN-100's rotation NED_from_FRD itself: its DCM output (row-major, as the
+// frame carries it: the real VN-100 logs in ../shared/data hold YPR and DCM in every frame,
+// and the DCM equals Rz(yaw) Ry(pitch) Rx(roll)), or its quaternion output (x, y, z, w; the
+// same rotation).
+[[nodiscard]] Eigen::Quaterniond enu_from_vn_rotation(const Eigen::Quaterniond& ned_from_frd,
+                                                      const ImuMounting& mounting = {});
 
 // Fallback headings when no IMU attitude is available (the yaw only; roll and pitch are then
 // taken as zero by the caller):

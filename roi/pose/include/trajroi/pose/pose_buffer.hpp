@@ -13,6 +13,8 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -66,8 +68,14 @@ enum class PoseStatus : std::uint8_t {
 struct PoseQuery {
   PoseStatus status = PoseStatus::kNoGnss;
   Eigen::Isometry3d global_from_robot = Eigen::Isometry3d::Identity();  // valid only if kValid
+  // For a failed gate, the figure that failed and its limit (fix type; h_acc m; age or gap s).
+  double measured = 0.0;
+  double limit = 0.0;
   [[nodiscard]] bool valid() const noexcept { return status == PoseStatus::kValid; }
 };
+// The status with its figures, e.g. "GNSS horizontal accuracy 2.52 m > limit 0.50 m
+// (pose.max_h_acc_m)"; the status text alone where it has none.
+[[nodiscard]] std::string describe(PoseStatus status, double measured, double limit);
 
 // Counts of samples refused on insertion.
 struct PoseBufferCounters {
@@ -89,6 +97,10 @@ class PoseBuffer {
 
   [[nodiscard]] PoseQuery pose_at(std::int64_t t_ns) const noexcept;
 
+  // A static pose (pose.source fixed: a parked sensor, a bench, a LiDAR-only replay): from now
+  // on pose_at() answers it, valid, at every time; the samples are not consulted.
+  void hold(const Eigen::Isometry3d& global_from_robot) noexcept { held_ = global_from_robot; }
+
   [[nodiscard]] const PoseBufferCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const PoseGate& gate() const noexcept { return gate_; }
   // The newest fix, or nullptr before the first.
@@ -107,13 +119,15 @@ class PoseBuffer {
     [[nodiscard]] std::size_t floor(std::int64_t t_ns) const noexcept;
   };
 
-  [[nodiscard]] PoseStatus check(const FixQuality& q) const noexcept;
+  // kValid, or the failing status with its figure and limit in `out`.
+  [[nodiscard]] PoseStatus check(const FixQuality& q, PoseQuery& out) const noexcept;
 
   PoseGate gate_;
   Eigen::Vector3d antenna_in_robot_m_;
   Ring<GnssFix> fixes_;
   Ring<AttitudeSample> attitudes_;
   PoseBufferCounters counters_;
+  std::optional<Eigen::Isometry3d> held_;
 };
 
 }  // namespace trajroi::pose
@@ -134,6 +148,8 @@ class FiringPoses {
     if (!have_ || t_ns < query_ns_ || t_ns - query_ns_ >= period_ns_) {
       const PoseQuery q = buffer_->pose_at(t_ns);
       status_ = q.status;
+      measured_ = q.measured;
+      limit_ = q.limit;
       have_ = true;
       query_ns_ = t_ns;
       ++generation_;
@@ -143,6 +159,9 @@ class FiringPoses {
     return status_ == PoseStatus::kValid ? &global_from_sensor_ : nullptr;
   }
   [[nodiscard]] std::uint64_t generation() const noexcept { return generation_; }
+  // The last query's failing figure and its limit (PoseQuery::measured, limit).
+  [[nodiscard]] double measured() const noexcept { return measured_; }
+  [[nodiscard]] double limit() const noexcept { return limit_; }
   void reset() noexcept { have_ = false; }
 
  private:
@@ -153,6 +172,7 @@ class FiringPoses {
   std::int64_t query_ns_ = 0;
   std::uint64_t generation_ = 0;
   PoseStatus status_ = PoseStatus::kNoGnss;
+  double measured_ = 0.0, limit_ = 0.0;
   Eigen::Isometry3d global_from_sensor_ = Eigen::Isometry3d::Identity();
 };
 
