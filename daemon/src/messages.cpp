@@ -30,6 +30,7 @@ void fill_pose(const Sweep& sweep, trajroi::pose_t& out) {
   out.valid = sweep.pose_status == pose::PoseStatus::kValid;
   out.status = static_cast<std::int8_t>(sweep.pose_status);
   out.status_text = pose::describe(sweep.pose_status, sweep.pose_measured, sweep.pose_limit);
+  out.heading_source = std::string(sweep.heading_source);
   set_pose(sweep.robot, out.position_m, out.orientation);
   out.yaw_rad = out.valid ? pose::roll_pitch_yaw(sweep.robot.orientation).yaw_rad : 0.0;
   out.speed_mps = sweep.speed_mps;

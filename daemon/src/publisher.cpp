@@ -107,10 +107,14 @@ void Publisher::publish_sweep(const Sweep& s) {
     send(config_.lcm.roi, roi_);
     fill_points(s, config_.pose_mode, points_);
     send(config_.lcm.points, points_);
-    const double latency_ms = static_cast<double>(steady_ns() - s.last_packet_arrival_ns) * 1e-6;
-    if (latency_window_ms_.size() < latency_window_ms_.capacity()) latency_window_ms_.push_back(latency_ms);
-    if (latency_minute_ms_.size() < latency_minute_ms_.capacity()) latency_minute_ms_.push_back(latency_ms);
-    latency_all_.add(latency_ms);
+    // A partial sweep's latency (the stream's end, flushed at a stop) is the wait for the stop,
+    // not the pipeline's: left out of the figures.
+    if (!s.partial) {
+      const double latency_ms = static_cast<double>(steady_ns() - s.last_packet_arrival_ns) * 1e-6;
+      if (latency_window_ms_.size() < latency_window_ms_.capacity()) latency_window_ms_.push_back(latency_ms);
+      if (latency_minute_ms_.size() < latency_minute_ms_.capacity()) latency_minute_ms_.push_back(latency_ms);
+      latency_all_.add(latency_ms);
+    }
   } else {
     warn_rate_limited(sweep_warn_limit_, "sweep " + std::to_string(s.index) + " withheld: no valid pose (" +
                                              pose::describe(s.pose_status, s.pose_measured, s.pose_limit) + ")");

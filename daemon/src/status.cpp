@@ -64,6 +64,9 @@ struct Names {
     set(C::kPoseMalformedMessages, "pose.malformed_messages");
     set(C::kPoseAttitudes, "pose.attitudes");
     set(C::kPoseImuWithoutAttitude, "pose.imu_without_attitude");
+    set(C::kPoseImuReceiveStamped, "pose.imu_receive_stamped");
+    set(C::kPoseGnssHeadings, "pose.gnss_headings");
+    set(C::kPoseUbxOther, "pose.ubx_other_messages");
     set(C::kPoseRefusedSamples, "pose.refused_samples");
     set(C::kPoseGnssClockResets, "pose.gnss_clock_resets");
     set(C::kPoseImuClockResets, "pose.imu_clock_resets");
@@ -161,6 +164,9 @@ void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64
   s[C::kPoseMalformedMessages] = pc.malformed;
   s[C::kPoseAttitudes] = pc.attitudes;
   s[C::kPoseImuWithoutAttitude] = pc.imu_without_attitude;
+  s[C::kPoseImuReceiveStamped] = pc.imu_receive_stamped;
+  s[C::kPoseGnssHeadings] = pc.gnss_headings;
+  s[C::kPoseUbxOther] = pc.ubx_other;
   s[C::kPoseRefusedSamples] = pc.refused;
   s[C::kPoseGnssClockResets] = in.gnss_clock().resets();
   s[C::kPoseImuClockResets] = in.imu_clock().resets();

@@ -186,6 +186,8 @@ void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
 
   const pose::PoseQuery q = poses_.pose_at(frame.start_time_ns);
   s.pose_status = q.status;
+  s.heading_source =
+      config_.pose_source == PoseSource::kFixed ? "fixed" : pose_input::to_string(pose_input_.heading_source());
   s.pose_measured = q.measured;
   s.pose_limit = q.limit;
   s.filtered = q.valid();

@@ -17,7 +17,8 @@ namespace {
 std::string lower_without_spaces(std::string_view text) {
   std::string out;
   for (const char c : text) {
-    if (std::isspace(static_cast<unsigned char>(c)) == 0) out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (std::isspace(static_cast<unsigned char>(c)) == 0)
+      out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   }
   return out;
 }
@@ -64,8 +65,10 @@ roi::Trajectory parse_trajectory(std::string_view text, const TrajectorySource& 
   if (coordinates == TrajectoryCoordinates::kGlobalXy) {
     bool all_near_origin_degrees = true;
     for (const Eigen::Vector2d& w : pairs.waypoints()) {
-      const bool lat_lon = std::abs(w.x() - source.origin.lat_deg) < 1.0 && std::abs(w.y() - source.origin.lon_deg) < 1.0;
-      const bool lon_lat = std::abs(w.x() - source.origin.lon_deg) < 1.0 && std::abs(w.y() - source.origin.lat_deg) < 1.0;
+      const bool lat_lon =
+          std::abs(w.x() - source.origin.lat_deg) < 1.0 && std::abs(w.y() - source.origin.lon_deg) < 1.0;
+      const bool lon_lat =
+          std::abs(w.x() - source.origin.lon_deg) < 1.0 && std::abs(w.y() - source.origin.lat_deg) < 1.0;
       all_near_origin_degrees = all_near_origin_degrees && (lat_lon || lon_lat);
     }
     if (all_near_origin_degrees && !(std::abs(source.origin.lat_deg) < 1.0 && std::abs(source.origin.lon_deg) < 1.0)) {

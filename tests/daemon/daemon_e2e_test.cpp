@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "daemon_fixture.hpp"
+#include "filter_check.hpp"
 #include "trajroi/roi/transform.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
 #include "trajroi/vlp16/stream_decoder.hpp"
@@ -34,85 +35,6 @@ fs::path write_config(const std::string& prefix, const std::string& pose_mode, c
 
 std::string unique_prefix(const char* name) {
   return "TRJTEST_" + std::to_string(::getpid()) + "_" + name;
-}
-
-// The capture decoded here, as trajroid's configuration asks (min 0.5 m, max 60 m).
-// The sensor pose a points_t publishes (the sweep's start).
-Eigen::Isometry3d sensor_pose(const trajroi::points_t& m) {
-  return trajroi::roi::pose_from_position_quaternion(
-      Eigen::Vector3d(m.sensor_position_m[0], m.sensor_position_m[1], m.sensor_position_m[2]),
-      Eigen::Quaterniond(m.sensor_orientation[0], m.sensor_orientation[1], m.sensor_orientation[2],
-                         m.sensor_orientation[3]));
-}
-
-// trajroi filter's --pose argument: x,y,z,qw,qx,qy,qz printed to round-trip exactly.
-std::string pose_argument(const Eigen::Vector3d& t, double qw, double qx, double qy, double qz) {
-  char text[512];
-  std::snprintf(text, sizeof text, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", t.x(), t.y(), t.z(), qw, qx, qy, qz);
-  return text;
-}
-
-std::string pose_argument(const Eigen::Isometry3d& g) {
-  const Eigen::Quaterniond q(g.rotation());
-  return pose_argument(g.translation(), q.w(), q.x(), q.y(), q.z());
-}
-
-// The published numbers themselves (no rotation-matrix round trip), for bit-exact comparison.
-std::string pose_argument(const trajroi::points_t& m) {
-  return pose_argument(Eigen::Vector3d(m.sensor_position_m[0], m.sensor_position_m[1], m.sensor_position_m[2]),
-                       m.sensor_orientation[0], m.sensor_orientation[1], m.sensor_orientation[2],
-                       m.sensor_orientation[3]);
-}
-
-// Indices `trajroi filter` keeps of `frame` placed with the sweep's published sensor pose, or
-// with `pose` (trajroi filter's --pose argument) when given.
-std::vector<std::uint32_t> filter_keeps(const trajroi::vlp16::Frame& frame, const trajroi::points_t& m,
-                                        const trajroi::roi_t& roi, const fs::path& dir, std::string pose = {}) {
-  if (pose.empty()) pose = pose_argument(m);
-  const fs::path points = dir / ("sweep" + std::to_string(m.sweep_index) + ".csv");
-  const fs::path indices = dir / ("sweep" + std::to_string(m.sweep_index) + ".idx");
-  {
-    std::FILE* f = std::fopen(points.c_str(), "w");
-    for (const auto& p : frame.points) {
-      std::fprintf(f, "%.17g,%.17g,%.17g\n", static_cast<double>(p.x), static_cast<double>(p.y),
-                   static_cast<double>(p.z));
-    }
-    std::fclose(f);
-  }
-  char chain[256];
-  std::snprintf(chain, sizeof chain,
-                " --shape circular --diameter %.17g --spacing %.17g --start-s %.17g --look-ahead %.17g",
-                2.0 * roi.radius_m, roi.spacing_m, roi.start_s_m, roi.look_ahead_m);
-  const std::string cmd = std::string(TRAJROI_CLI) + " filter --trajectory " +
-                          (corridor_run() / "trajectory.csv").string() + " --points " + points.string() + " --pose " +
-                          pose + chain + " --cloud-precision float --output-indices " + indices.string() +
-                          " 2>/dev/null";
-  EXPECT_EQ(run_command(cmd), 0) << cmd;
-  std::vector<std::uint32_t> kept;
-  std::istringstream in(slurp(indices));
-  for (std::uint32_t i; in >> i;)
-    kept.push_back(i);
-  return kept;
-}
-
-// Which decoded points a points_t holds, by (firing time, ring, return type).
-std::vector<std::uint32_t> daemon_keeps(const trajroi::vlp16::Frame& frame, const trajroi::points_t& m) {
-  std::map<std::tuple<std::int64_t, int, int>, std::uint32_t> index;
-  for (std::uint32_t i = 0; i < frame.points.size(); ++i) {
-    const auto& p = frame.points[i];
-    index[{static_cast<std::int64_t>(frame.start_time_ns) + p.time_offset_ns, p.ring,
-           static_cast<int>(p.return_type)}] = i;
-  }
-  std::vector<std::uint32_t> kept;
-  for (std::size_t k = 0; k < static_cast<std::size_t>(m.num_points); ++k) {
-    const auto it = index.find({m.sweep_start_ns + m.time_offset_ns[k], m.ring[k], m.return_type[k]});
-    if (it == index.end()) {
-      ADD_FAILURE() << "sweep " << m.sweep_index << " point " << k << " is not a decoded point";
-      return {};
-    }
-    kept.push_back(it->second);
-  }
-  return kept;
 }
 
 // Seven complete, published sweeps spread over the run (the frame and its points_t), for the
@@ -206,7 +128,8 @@ TEST(TrajroidEndToEnd, EverySweepArrivesAndMatchesTrajroiFilterExactlyWithOnePos
   for (const auto& [frame, message] : sampled) {
     const trajroi::points_t& m = *message;
     const std::int64_t idx = m.sweep_index;
-    const auto expected = filter_keeps(*frame, m, listener.rois.at(idx), corridor_run());
+    const auto expected =
+        filter_keeps(*frame, m, listener.rois.at(idx), corridor_run(), corridor_run() / "trajectory.csv");
     const auto got = daemon_keeps(*frame, m);
     ASSERT_GT(expected.size(), 1000u);
     EXPECT_EQ(got, expected) << "sweep " << idx;
@@ -253,8 +176,8 @@ TEST(TrajroidEndToEnd, PerFiringMotionCompensationDiffersFromTheMidSweepPoseOnly
     middle.linear() =
         Eigen::Quaterniond(start.rotation()).slerp(0.5, Eigen::Quaterniond(end.rotation())).toRotationMatrix();
     middle.translation() = 0.5 * (start.translation() + end.translation());
-    const auto expected =
-        filter_keeps(*frame, m, listener.rois.at(m.sweep_index), corridor_run(), pose_argument(middle));
+    const auto expected = filter_keeps(*frame, m, listener.rois.at(m.sweep_index), corridor_run(),
+                                       corridor_run() / "trajectory.csv", pose_argument(middle));
     ASSERT_TRUE(std::is_sorted(expected.begin(), expected.end()));
     auto got = daemon_keeps(*frame, m);
     std::sort(got.begin(), got.end());

@@ -18,15 +18,18 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "commands.hpp"
+#include "trajroi/framing/little_endian.hpp"
 #include "trajroi/inputs/pacer.hpp"
 #include "trajroi/inputs/run_merger.hpp"
 #include "trajroi/vlp16/packet_source.hpp"
+#include "trajroi/vlp16/pcap_source.hpp"
 
 namespace trajroi::cli {
 namespace {
@@ -63,6 +66,13 @@ Hangup parse_hangup(const std::string& text) {
 
 struct FeedOptions {
   std::string run_dir;
+  // Or real captures, each paced by its own recorded time: a pcap (UDP payloads by their
+  // destination port), a raw UBX log (by the epochs' iTOW), a raw VN-100 log from the
+  // LoggerWavesInIce logger (by its `M,<millis>` markers, else at --vn100-rate).
+  std::string pcap, ubx, vn100;
+  double lidar_after_s = 0.0;  // the capture's first datagram this long into the serial data
+  double vn100_rate_hz = 10.0;
+  double until_s = 0.0;  // > 0: stop after this much data (a long serial log)
   double rate = 1.0;
   std::uint16_t data_port = vlp16::kDataPort;
   std::uint16_t position_port = vlp16::kPositionPort;
@@ -219,17 +229,192 @@ std::vector<std::uint8_t> malformed(std::span<const std::uint8_t> real, std::uin
   return out;
 }
 
+// ---- real captures ------------------------------------------------------------------------
+
+// One paced piece of a capture, in a merged list.
+struct TimedChunk {
+  std::int64_t t_ns = 0;  // from the start of the feed
+  inputs::Stream stream = inputs::Stream::kGnss;
+  std::vector<std::uint8_t> bytes;
+};
+
+std::vector<std::uint8_t> read_bytes(const std::string& file) {
+  std::FILE* f = std::fopen(file.c_str(), "rb");
+  if (f == nullptr) throw std::runtime_error(file + ": " + std::strerror(errno));
+  std::vector<std::uint8_t> bytes;
+  std::uint8_t buffer[65536];
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, f)) > 0;)
+    bytes.insert(bytes.end(), buffer, buffer + n);
+  std::fclose(f);
+  return bytes;
+}
+
+// A raw UBX log cut after each epoch's last NAV message (NAV-EOE, else NAV-PVT), each chunk
+// timed by its epoch's iTOW: the receiver's own pace. Bytes that are no UBX (NMEA, noise)
+// travel with the chunk they sit in.
+std::vector<TimedChunk> ubx_chunks(const std::string& file) {
+  const std::vector<std::uint8_t> b = read_bytes(file);
+  const bool has_eoe = [&] {
+    for (std::size_t i = 0; i + 3 < b.size(); ++i)
+      if (b[i] == 0xB5 && b[i + 1] == 0x62 && b[i + 2] == 0x01 && b[i + 3] == 0x61) return true;
+    return false;
+  }();
+  std::vector<TimedChunk> out;
+  std::size_t chunk_start = 0;
+  std::optional<std::uint32_t> first_itow;
+  for (std::size_t i = 0; i + 8 <= b.size();) {
+    if (b[i] != 0xB5 || b[i + 1] != 0x62) {
+      ++i;
+      continue;
+    }
+    const std::size_t length = b[i + 4] | (static_cast<std::size_t>(b[i + 5]) << 8);
+    const std::size_t end = i + 6 + length + 2;
+    if (end > b.size()) break;
+    std::uint8_t ck_a = 0, ck_b = 0;
+    for (std::size_t k = i + 2; k < i + 6 + length; ++k) {
+      ck_a = static_cast<std::uint8_t>(ck_a + b[k]);
+      ck_b = static_cast<std::uint8_t>(ck_b + ck_a);
+    }
+    if (ck_a != b[end - 2] || ck_b != b[end - 1]) {
+      ++i;
+      continue;
+    }
+    const bool nav = b[i + 2] == 0x01;
+    const std::uint8_t id = b[i + 3];
+    if (nav && length >= 4 && (id == (has_eoe ? 0x61 : 0x07))) {
+      const std::uint32_t itow = framing::le_u32(std::span<const std::uint8_t>(b), i + 6);
+      if (!first_itow) first_itow = itow;
+      TimedChunk c;
+      c.t_ns = (static_cast<std::int64_t>(itow) - static_cast<std::int64_t>(*first_itow)) * 1'000'000;
+      c.stream = inputs::Stream::kGnss;
+      c.bytes.assign(b.begin() + static_cast<std::ptrdiff_t>(chunk_start),
+                     b.begin() + static_cast<std::ptrdiff_t>(end));
+      if (!out.empty() && c.t_ns < out.back().t_ns) c.t_ns = out.back().t_ns;  // a week wrap: keep order
+      out.push_back(std::move(c));
+      chunk_start = end;
+    }
+    i = end;
+  }
+  if (out.empty()) throw std::runtime_error(file + ": no UBX NAV epoch found");
+  return out;
+}
+
+// A raw VN-100 log cut after each `M,<millis>\r\n` marker of the LoggerWavesInIce logger, timed
+// by it; without markers, cut after each binary frame's sync at `rate_hz`.
+std::vector<TimedChunk> vn100_chunks(const std::string& file, double rate_hz) {
+  const std::vector<std::uint8_t> b = read_bytes(file);
+  std::vector<TimedChunk> out;
+  std::size_t chunk_start = 0;
+  std::optional<std::int64_t> first_ms;
+  for (std::size_t i = 0; i + 4 < b.size(); ++i) {
+    if (!(b[i] == 'M' && b[i + 1] == ',' && (i == 0 || b[i - 1] == '\n'))) continue;
+    std::size_t k = i + 2;
+    std::int64_t ms = 0;
+    while (k < b.size() && k < i + 14 && b[k] >= '0' && b[k] <= '9')
+      ms = ms * 10 + (b[k++] - '0');
+    if (k == i + 2 || k + 1 >= b.size() || b[k] != '\r' || b[k + 1] != '\n') continue;
+    if (!first_ms) first_ms = ms;
+    TimedChunk c;
+    c.t_ns = (ms - *first_ms) * 1'000'000;
+    // A marker out of order (bytes that only looked like one) keeps the previous time.
+    if (!out.empty() && (c.t_ns < out.back().t_ns || c.t_ns > out.back().t_ns + 10'000'000'000))
+      c.t_ns = out.back().t_ns;
+    c.stream = inputs::Stream::kImu;
+    c.bytes.assign(b.begin() + static_cast<std::ptrdiff_t>(chunk_start),
+                   b.begin() + static_cast<std::ptrdiff_t>(k + 2));
+    out.push_back(std::move(c));
+    chunk_start = k + 2;
+  }
+  if (out.empty()) {
+    if (!(rate_hz > 0.0)) throw std::invalid_argument("--vn100-rate must be > 0");
+    const auto period_ns = static_cast<std::int64_t>(1e9 / rate_hz);
+    for (std::size_t i = 1; i <= b.size(); ++i) {
+      if (i == b.size() || b[i] == 0xFA) {
+        TimedChunk c;
+        c.t_ns = static_cast<std::int64_t>(out.size()) * period_ns;
+        c.stream = inputs::Stream::kImu;
+        c.bytes.assign(b.begin() + static_cast<std::ptrdiff_t>(chunk_start),
+                       b.begin() + static_cast<std::ptrdiff_t>(i));
+        out.push_back(std::move(c));
+        chunk_start = i;
+      }
+    }
+  }
+  return out;
+}
+
+// The capture's UDP payloads at their recorded spacing, from `start_ns`.
+std::vector<TimedChunk> pcap_chunks(const std::string& file, std::int64_t start_ns, std::uint16_t position_port) {
+  vlp16::PcapSource source(file);
+  std::vector<TimedChunk> out;
+  vlp16::Datagram d;
+  std::optional<std::int64_t> first;
+  while (source.next(d) == vlp16::PacketSource::Next::kDatagram) {
+    if (!first) first = d.receive_time_ns;
+    TimedChunk c;
+    c.t_ns = start_ns + (d.receive_time_ns - *first);
+    c.stream = d.destination_port == position_port ? inputs::Stream::kLidarPosition : inputs::Stream::kLidarData;
+    c.bytes.assign(d.payload.begin(), d.payload.end());
+    out.push_back(std::move(c));
+  }
+  if (!source.error().empty()) throw std::runtime_error(file + ": " + source.error());
+  return out;
+}
+
+// Every capture asked for, merged in time order (ties: GNSS, IMU, LiDAR, as the run merger).
+std::vector<TimedChunk> capture_chunks(const FeedOptions& o) {
+  std::vector<TimedChunk> all;
+  const auto append = [&all](std::vector<TimedChunk> more) {
+    for (TimedChunk& c : more)
+      all.push_back(std::move(c));
+  };
+  if (!o.ubx.empty()) append(ubx_chunks(o.ubx));
+  if (!o.vn100.empty()) append(vn100_chunks(o.vn100, o.vn100_rate_hz));
+  if (!o.pcap.empty()) {
+    append(pcap_chunks(o.pcap, static_cast<std::int64_t>(o.lidar_after_s * 1e9), vlp16::kPositionPort));
+  }
+  const auto rank = [](inputs::Stream s) { return s == inputs::Stream::kGnss ? 0 : s == inputs::Stream::kImu ? 1 : 2; };
+  std::stable_sort(all.begin(), all.end(), [&](const TimedChunk& a, const TimedChunk& b) {
+    return a.t_ns != b.t_ns ? a.t_ns < b.t_ns : rank(a.stream) < rank(b.stream);
+  });
+  return all;
+}
+
 void run_feed(const FeedOptions& o) {
   if (!(o.rate > 0.0)) throw std::invalid_argument("--rate must be > 0");
   if (o.foreign_every == 0) throw std::invalid_argument("--foreign-every must be >= 1");
   const fs::path dir = o.run_dir;
-  // The run's recordings in receive-time order (the daemon's own merger), paced by the pacer.
+  // The run's recordings in receive-time order (the daemon's own merger), or the real
+  // captures merged by their own times; either paced by the pacer.
   inputs::RunStreams streams;
   streams.gnss = !o.gnss_link.empty();
   streams.imu = !o.imu_link.empty();
-  inputs::RunMerger merger(dir, streams);
-  for (const std::string& missing : merger.missing())
-    throw std::runtime_error(missing + ": not found");
+  std::unique_ptr<inputs::RunMerger> merger;
+  std::vector<TimedChunk> chunks;
+  std::size_t next_chunk = 0;
+  if (o.run_dir.empty()) {
+    if (o.pcap.empty() && o.ubx.empty() && o.vn100.empty()) {
+      throw std::invalid_argument("feed: give a run folder, or captures (--pcap, --ubx, --vn100)");
+    }
+    if (!o.ubx.empty() && !streams.gnss) throw std::invalid_argument("--ubx needs --gnss-link");
+    if (!o.vn100.empty() && !streams.imu) throw std::invalid_argument("--vn100 needs --imu-link");
+    streams.gnss = !o.ubx.empty();
+    streams.imu = !o.vn100.empty();
+    chunks = capture_chunks(o);
+  } else {
+    merger = std::make_unique<inputs::RunMerger>(dir, streams);
+    for (const std::string& missing : merger->missing())
+      throw std::runtime_error(missing + ": not found");
+  }
+  const auto next_item = [&](inputs::InputItem& item) {
+    if (merger) return merger->next(item);
+    if (next_chunk == chunks.size()) return false;
+    const TimedChunk& c = chunks[next_chunk++];
+    item.stream = c.stream;
+    item.bytes = c.bytes;
+    item.receive_ns = c.t_ns;
+    return true;
+  };
   std::unique_ptr<PtyDevice> gnss_dev, imu_dev;
   if (streams.gnss) gnss_dev = std::make_unique<PtyDevice>("gnss", o.gnss_link);
   if (streams.imu) imu_dev = std::make_unique<PtyDevice>("imu", o.imu_link);
@@ -250,7 +435,8 @@ void run_feed(const FeedOptions& o) {
   }
 
   std::int64_t t0 = 0;
-  if (!merger.peek_time(t0)) throw std::runtime_error(dir.string() + ": nothing to feed");
+  if (merger ? !merger->peek_time(t0) : chunks.empty()) throw std::runtime_error("feed: nothing to feed");
+  if (!merger) t0 = chunks.front().t_ns;
   inputs::Pacer pacer(o.rate);
   const std::int64_t start = inputs::monotonic_ns();
   double data_s = 0.0;
@@ -263,8 +449,9 @@ void run_feed(const FeedOptions& o) {
   double flood_credit = 0.0;
 
   inputs::InputItem item;
-  while (merger.next(item)) {
+  while (next_item(item)) {
     data_s = static_cast<double>(item.receive_ns - t0) * 1e-9;
+    if (o.until_s > 0.0 && data_s > o.until_s) break;
     inputs::Pacer::sleep_until(pacer.due_ns(item.receive_ns));
 
     for (std::size_t i = 0; i < hangups.size(); ++i) {  // devices coming back
@@ -337,9 +524,21 @@ void add_feed_command(CLI::App& app) {
   auto o = std::make_shared<FeedOptions>();
   CLI::App* cmd = app.add_subcommand(
       "feed", "Play a run folder into a live trajroid: UDP to 127.0.0.1, serial streams through pseudo-terminals");
-  cmd->add_option("run", o->run_dir, "Run folder (lidar.pcap, gnss.trjb, imu.trjb)")
-      ->required()
+  cmd->add_option("run", o->run_dir, "Run folder (lidar.pcap, gnss.trjb, imu.trjb); or real captures below")
       ->check(CLI::ExistingDirectory);
+  cmd->add_option("--pcap", o->pcap, "Real capture: a pcap whose UDP payloads are sent at their recorded spacing")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--ubx", o->ubx,
+                  "Real capture: a raw UBX log, written to --gnss-link epoch by epoch at its iTOW pace")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--vn100", o->vn100,
+                  "Real capture: a raw VN-100 log, written to --imu-link at its logger's M,<millis> pace")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--lidar-after", o->lidar_after_s, "With --pcap: its first datagram this many seconds into the feed")
+      ->capture_default_str();
+  cmd->add_option("--until", o->until_s, "Stop after this many seconds of data (0: all of it)")->capture_default_str();
+  cmd->add_option("--vn100-rate", o->vn100_rate_hz, "With --vn100 and no logger markers: frames per second")
+      ->capture_default_str();
   cmd->add_option("--rate", o->rate, "Pace: 1 real time, N × real time")->capture_default_str();
   cmd->add_option("--data-port", o->data_port, "UDP port for data packets")->capture_default_str();
   cmd->add_option("--position-port", o->position_port, "UDP port for position packets")->capture_default_str();

@@ -66,6 +66,7 @@ struct Sweep {
   bool filtered = false;
   pose::PoseStatus pose_status = pose::PoseStatus::kNoGnss;
   double pose_measured = 0.0, pose_limit = 0.0;  // the failing figure and its limit (PoseQuery)
+  std::string_view heading_source = "none";      // where the attitude came from (static text)
   std::int64_t pose_t_ns = 0;                    // sweep start
   PublishedPose robot;                           // global_from_robot at the start
   PublishedPose sensor;                          // global_from_lidar at the start (used for the whole

@@ -1,0 +1,175 @@
+// trajroid on real bytes recorded by others, the way a robot runs it: the MRPT VLP-16 capture's
+// payloads sent over UDP to 127.0.0.1 at their recorded spacing, the u-blox NEO-M8P log
+// (gpsd's regression suite) written into a pseudo-terminal epoch by epoch at its iTOW pace, the
+// VN-100 log of the LoggerWavesInIce logger (binary output with YawPitchRoll and DCM, no time
+// field) into another at its logger's pace. The trajectory is written in latitude/longitude
+// through the u-blox fix. Published sweeps must come with a valid pose within 10 s, and their
+// kept points must be exactly what `trajroi filter` keeps of the same sweep (decoded here from
+// the pcap) placed with the same published pose. Once per pose source: gnss_imu, gnss (the
+// receiver is parked: the configured initial heading, held), fixed (LiDAR alone).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "daemon_fixture.hpp"
+#include "filter_check.hpp"
+#include "test_data.hpp"
+#include "trajroi/pose/geodetic.hpp"
+
+namespace {
+
+using namespace daemon_test;
+using std::chrono::milliseconds;
+using std::chrono::seconds;
+
+constexpr const char* kPcap = "velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap";
+constexpr const char* kUbx = "ublox/gpsd/ublox-neo-m8p.log";
+constexpr const char* kVn100 = "vectornav/LoggerWavesInIce_F00379.raw";
+
+// The global frame's origin, a few metres from the receiver's fix (50.1350851 N, 14.4299466 E,
+// 348.86 m), and a north-south trajectory 0.24 m east of the fix, as latitude/longitude. The
+// capture's returns all lie within 2.8 m of the sensor (a small room): 1.2 m circles over 6 m
+// ahead keep a part of each sweep.
+const trajroi::pose::Geodetic kOrigin{50.13505, 14.42990, 348.0};
+constexpr const char* kTrajectoryLatLon = "lat,lon\n50.13480,14.42995\n50.13540,14.42995\n";
+
+struct Rig {
+  std::string prefix;
+  fs::path dir, config, gnss_link, imu_link, daemon_log, feed_log, trajectory_xy;
+  int data_port = 0;
+
+  Rig(const std::string& name, const std::string& source, int port_offset) {
+    const int pid = ::getpid();
+    prefix = "TRJREAL_" + std::to_string(pid) + "_" + name;
+    dir = fs::temp_directory_path() / ("trajroid_real_" + name + "_" + std::to_string(pid));
+    fs::create_directories(dir);
+    data_port = 24000 + (pid % 2000) * 8 + port_offset * 2;
+    gnss_link = dir / "gnss";
+    imu_link = dir / "imu";
+    daemon_log = dir / "trajroid.log";
+    feed_log = dir / "feed.log";
+    std::ofstream(dir / "trajectory.csv") << kTrajectoryLatLon;
+    // The same trajectory in global-frame metres, for trajroi filter.
+    const auto frame = trajroi::pose::GlobalFrame::local_cartesian(kOrigin);
+    trajectory_xy = dir / "trajectory_xy.csv";
+    std::ofstream xy(trajectory_xy);
+    xy.precision(17);
+    for (const double lat : {50.13480, 50.13540}) {
+      const Eigen::Vector3d g = frame.to_global(trajroi::pose::Geodetic{lat, 14.42995, kOrigin.height_m});
+      xy << g.x() << "," << g.y() << "\n";
+    }
+    char origin[160];
+    std::snprintf(origin, sizeof origin, "{lat_deg: %.8f, lon_deg: %.8f, height_m: %.3f}", kOrigin.lat_deg,
+                  kOrigin.lon_deg, kOrigin.height_m);
+    std::string text = std::string("global_frame:\n  origin: ") + origin +
+                       "\ntrajectory:\n  file: trajectory.csv\n"
+                       "lidar:\n  data_port: " +
+                       std::to_string(data_port) + "\n  position_port: " + std::to_string(data_port + 1) +
+                       "\n  min_range_m: 0.5\n  max_range_m: 60\n";
+    if (source != "fixed") text += "gnss:\n  device: " + gnss_link.string() + "\n";
+    if (source == "gnss_imu") text += "imu:\n  device: " + imu_link.string() + "\n";
+    text += "pose:\n  source: " + source + "\n  mode: per_sweep\n";
+    // Parked receiver: no course over ground; the robot faces north-east until it moves.
+    if (source == "gnss") text += "  gnss_heading: {initial_heading_deg: 30}\n";
+    if (source == "fixed") text += "  fixed: {xyz: [3.3, 2.0, 0.5], yaw_deg: 60}\n";
+    text += "roi:\n  circle_diameter_m: 1.2\n  look_ahead_m: 6\n";
+    text += "lcm:\n  channels: {points: " + prefix + "_POINTS, pose: " + prefix + "_POSE, roi: " + prefix +
+            "_ROI, status: " + prefix + "_STATUS, trajectory: " + prefix + "_TRAJECTORY}\n";
+    config = dir / "trajroid.yaml";
+    std::ofstream(config) << text;
+  }
+  ~Rig() {
+    std::error_code ignored;
+    fs::remove_all(dir, ignored);
+  }
+  [[nodiscard]] std::string logs() const {
+    return "--- config ---\n" + slurp(config) + "--- trajroid log ---\n" + slurp(daemon_log) + "--- feed log ---\n" +
+           slurp(feed_log);
+  }
+};
+
+class RealCaptures : public testing::TestWithParam<const char*> {};
+
+TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKeeps) {
+  TRAJROI_REQUIRE_DATA(pcap, kPcap);
+  TRAJROI_REQUIRE_DATA(ubx, kUbx);
+  TRAJROI_REQUIRE_DATA(vn100, kVn100);
+  const std::string source = GetParam();
+  const Rig rig(source, source, source == std::string("gnss_imu") ? 0 : source == std::string("gnss") ? 1 : 2);
+  Listener listener(rig.prefix);
+  ASSERT_TRUE(listener.good());
+  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
+
+  std::vector<std::string> feed{"feed",
+                                "--pcap",
+                                pcap.string(),
+                                "--lidar-after",
+                                "3",
+                                "--data-port",
+                                std::to_string(rig.data_port),
+                                "--position-port",
+                                std::to_string(rig.data_port + 1),
+                                "--until",
+                                "5",
+                                "--linger",
+                                "2"};
+  if (source != std::string("fixed")) {
+    feed.insert(feed.end(), {"--ubx", ubx.string(), "--gnss-link", rig.gnss_link.string()});
+  }
+  if (source == std::string("gnss_imu")) {
+    feed.insert(feed.end(), {"--vn100", vn100.string(), "--imu-link", rig.imu_link.string()});
+  }
+  const auto feed_start = std::chrono::steady_clock::now();
+  Child feeder(TRAJROI_CLI, feed, rig.feed_log);
+
+  // The first published sweep, with its valid pose, within 10 s of the sensors starting.
+  ASSERT_TRUE(listener.wait_for([&] { return !listener.points.empty(); }, seconds(10))) << rig.logs();
+  const double first_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - feed_start).count();
+  std::printf("[ real captures ] pose source %s: first sweep published %.2f s after the feed started\n",
+              source.c_str(), first_s);
+
+  ASSERT_EQ(feeder.wait(seconds(60)), 0) << rig.logs();
+  std::this_thread::sleep_for(milliseconds(300));
+  daemon.signal(SIGTERM);
+  ASSERT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+
+  const auto frames = decode_capture(pcap);
+  std::lock_guard<std::mutex> lock(listener.mutex);
+  std::size_t compared = 0;
+  for (const auto& frame : frames) {
+    const auto it = listener.points.find(static_cast<std::int64_t>(frame.index));
+    if (frame.partial || it == listener.points.end()) continue;
+    const trajroi::points_t& m = it->second;
+    EXPECT_TRUE(m.pose.valid);
+    EXPECT_EQ(m.points_in, static_cast<std::int32_t>(frame.points.size())) << "sweep " << frame.index;
+    const std::string expected_heading = source == std::string("gnss_imu") ? "imu"
+                                         : source == std::string("gnss")   ? "configured initial heading"
+                                                                           : "fixed";
+    EXPECT_EQ(m.pose.heading_source, expected_heading);
+    const auto expected = filter_keeps(frame, m, listener.rois.at(m.sweep_index), rig.dir, rig.trajectory_xy);
+    const auto got = daemon_keeps(frame, m);
+    // Some of the sweep, not all and not nothing: the circles cut through it.
+    EXPECT_GT(expected.size(), 100u) << "sweep " << frame.index;
+    EXPECT_LT(expected.size(), frame.points.size() * 9 / 10) << "sweep " << frame.index;
+    EXPECT_EQ(got, expected) << "sweep " << frame.index;
+    std::printf("[ real captures ] sweep %llu: %zu of %zu points kept, as trajroi filter keeps\n",
+                static_cast<unsigned long long>(frame.index), got.size(), frame.points.size());
+    ++compared;
+  }
+  EXPECT_GE(compared, 2u) << rig.logs();
+  ASSERT_FALSE(listener.statuses.empty());
+  const trajroi::status_t& last = listener.statuses.back();
+  EXPECT_EQ(last.lost_packets, 0) << rig.logs();
+  EXPECT_EQ(last.decode_errors, 0) << rig.logs();
+  if (source == std::string("gnss_imu")) {
+    // Every frame of the IMU stream had an attitude and no sensor time: placed at receipt.
+    EXPECT_GT(counter(last, "pose.attitudes"), 10);
+    EXPECT_EQ(counter(last, "pose.imu_without_attitude"), 0);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(PoseSources, RealCaptures, testing::Values("gnss_imu", "gnss", "fixed"),
+                         [](const testing::TestParamInfo<const char*>& p) { return std::string(p.param); });
+
+}  // namespace
