@@ -157,6 +157,8 @@ std::string_view to_string(PoseSource source) noexcept {
       return "gnss_imu";
     case PoseSource::kGnss:
       return "gnss";
+    case PoseSource::kLcm:
+      return "lcm";
     case PoseSource::kFixed:
       return "fixed";
   }
@@ -224,8 +226,9 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
   }
   {
     MapReader p = r.map("pose", true);
-    const std::string source = p.choice("source", {"gnss_imu", "gnss", "fixed"}, "gnss_imu");
+    const std::string source = p.choice("source", {"gnss_imu", "gnss", "lcm", "fixed"}, "gnss_imu");
     c.pose_source = source == "gnss"    ? PoseSource::kGnss
+                    : source == "lcm"   ? PoseSource::kLcm
                     : source == "fixed" ? PoseSource::kFixed
                                         : PoseSource::kGnssImu;
     if (p.has("gnss_heading")) {
@@ -296,6 +299,7 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
       channel("roi", c.lcm.roi);
       channel("status", c.lcm.status);
       channel("trajectory", c.lcm.trajectory);
+      channel("pose_input", c.lcm.pose_input);
       ch.finish();
     }
     l.finish();
@@ -445,6 +449,7 @@ std::string describe(const DaemonConfig& c) {
   line("lcm.channels.roi", c.lcm.roi);
   line("lcm.channels.status", c.lcm.status);
   line("lcm.channels.trajectory", c.lcm.trajectory);
+  line("lcm.channels.pose_input", c.lcm.pose_input);
   num("buffers.lidar_packets", static_cast<double>(c.buffers.lidar_packets));
   num("buffers.serial_chunks", static_cast<double>(c.buffers.serial_chunks));
   num("buffers.sweeps", static_cast<double>(c.buffers.sweeps));

@@ -87,6 +87,9 @@ class Processing {
       case inputs::Stream::kImu:
         processor_.imu_bytes(bytes, item.receive_ns);
         break;
+      case inputs::Stream::kPose:
+        processor_.pose_message(bytes, item.receive_ns);
+        break;
     }
     if (pipeline_.record) {
       const auto on_full = [this] {

@@ -1,5 +1,7 @@
 // The recorder: every item the processing thread handled, written as a run folder (lidar.pcap,
-// gnss.trjb, imu.trjb) that replays to the same output.
+// gnss.trjb, imu.trjb, pose.trjb with pose.source lcm) that replays to the same output.
+#include <memory>
+
 #include "log.hpp"
 #include "threads.hpp"
 #include "trajroi/inputs/run_merger.hpp"
@@ -14,6 +16,7 @@ void record_to(Pipeline& pipeline, const std::filesystem::path& dir) {
   vlp16::PcapWriter pcap(dir / inputs::kLidarFile);
   serial::RecordingWriter gnss((dir / inputs::kGnssFile).string());
   serial::RecordingWriter imu((dir / inputs::kImuFile).string());
+  std::unique_ptr<serial::RecordingWriter> pose;  // made at the first pose message
   Ring<InputSlot>& ring = *pipeline.record;
   for (;;) {
     bool any = false;
@@ -32,6 +35,10 @@ void record_to(Pipeline& pipeline, const std::filesystem::path& dir) {
         case inputs::Stream::kImu:
           imu.write(serial::Chunk{bytes, s->receive_ns});
           break;
+        case inputs::Stream::kPose:
+          if (!pose) pose = std::make_unique<serial::RecordingWriter>((dir / inputs::kPoseFile).string());
+          pose->write(serial::Chunk{bytes, s->receive_ns});
+          break;
       }
       ring.release();
       any = true;
@@ -42,6 +49,7 @@ void record_to(Pipeline& pipeline, const std::filesystem::path& dir) {
   pcap.close();
   gnss.flush();
   imu.flush();
+  if (pose) pose->flush();
 }
 
 }  // namespace

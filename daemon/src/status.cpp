@@ -67,6 +67,10 @@ struct Names {
     set(C::kPoseImuReceiveStamped, "pose.imu_receive_stamped");
     set(C::kPoseGnssHeadings, "pose.gnss_headings");
     set(C::kPoseUbxOther, "pose.ubx_other_messages");
+    set(C::kPoseExternal, "pose.localization_poses");
+    set(C::kPoseExternalInvalid, "pose.localization_invalid");
+    set(C::kPoseMessagesMalformed, "pose.localization_malformed");
+    set(C::kRingDropsPose, "ring_drops.pose_input");
     set(C::kPoseRefusedSamples, "pose.refused_samples");
     set(C::kPoseGnssClockResets, "pose.gnss_clock_resets");
     set(C::kPoseImuClockResets, "pose.imu_clock_resets");
@@ -123,6 +127,7 @@ void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64
     s[C::kRingDropsLidar] += drops(inputs::Stream::kLidarData) + drops(inputs::Stream::kLidarPosition);
     s[C::kRingDropsGnss] += drops(inputs::Stream::kGnss);
     s[C::kRingDropsImu] += drops(inputs::Stream::kImu);
+    s[C::kRingDropsPose] += drops(inputs::Stream::kPose);
     s[C::kLidarOversize] += lane->oversize.load(std::memory_order_relaxed);
     s[C::kLidarRejectedSource] += lane->rejected_sources.load(std::memory_order_relaxed);
     s[C::kLidarKernelDrops] += lane->kernel_drops.load(std::memory_order_relaxed);
@@ -167,6 +172,9 @@ void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64
   s[C::kPoseImuReceiveStamped] = pc.imu_receive_stamped;
   s[C::kPoseGnssHeadings] = pc.gnss_headings;
   s[C::kPoseUbxOther] = pc.ubx_other;
+  s[C::kPoseExternal] = pc.external_poses;
+  s[C::kPoseExternalInvalid] = pc.external_invalid;
+  s[C::kPoseMessagesMalformed] = p.counters().pose_messages_malformed;
   s[C::kPoseRefusedSamples] = pc.refused;
   s[C::kPoseGnssClockResets] = in.gnss_clock().resets();
   s[C::kPoseImuClockResets] = in.imu_clock().resets();

@@ -7,6 +7,8 @@
 #include <stdexcept>
 
 #include "trajroi/config/text_file.hpp"
+#include "trajroi/framing/little_endian.hpp"
+#include "trajroi/pose_input_t.hpp"
 #include "trajroi/roi/transform.hpp"
 
 namespace trajroi::daemon {
@@ -104,7 +106,9 @@ class SweepProcessor::FrameAdapter final : public vlp16::FrameSink {
 SweepProcessor::SweepProcessor(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> trajectory)
     : config_(config),
       decoder_(load_calibration(config.lidar.calibration), stream_options(config)),
-      poses_(config.gate, config.gnss_antenna_m, config.pose_capacity),
+      // A localization's pose is the robot origin's own: no lever arm.
+      poses_(config.gate, config.pose_source == PoseSource::kLcm ? Eigen::Vector3d::Zero() : config.gnss_antenna_m,
+             config.pose_capacity),
       pose_input_(pose::GlobalFrame::local_cartesian(config.origin), pose_input_config(config), poses_),
       firing_(
           poses_, config.lidar.robot_from_lidar,
@@ -140,6 +144,35 @@ void SweepProcessor::lidar_datagram(LidarPort port, std::span<const std::uint8_t
   }
   FrameAdapter adapter(*this, sink);
   decoder_.on_data_packet(payload, receive_ns, adapter);
+}
+
+void SweepProcessor::pose_message(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) {
+  (void)receive_ns;  // the message carries its own time
+  trajroi::pose_input_t m;
+  if (bytes.size() < 8 ||
+      m.decode(bytes.data() + 8, 0, static_cast<int>(bytes.size() - 8)) != static_cast<int>(bytes.size() - 8)) {
+    ++counters_.pose_messages_malformed;
+    return;
+  }
+  const auto utc_minus_monotonic = static_cast<std::int64_t>(framing::le_u64(bytes, 0));
+  pose_input::ExternalPose p;
+  if (m.clock == trajroi::pose_input_t::STAMP_UTC) {
+    p.t_ns = m.t_ns - utc_minus_monotonic;
+  } else if (m.clock == trajroi::pose_input_t::STAMP_MONOTONIC) {
+    p.t_ns = m.t_ns;
+  } else {
+    ++counters_.pose_messages_malformed;
+    return;
+  }
+  if (m.frame != trajroi::pose_input_t::GLOBAL_XY && m.frame != trajroi::pose_input_t::LAT_LON) {
+    ++counters_.pose_messages_malformed;
+    return;
+  }
+  p.lat_lon = m.frame == trajroi::pose_input_t::LAT_LON;
+  p.position = Eigen::Vector3d(m.position[0], m.position[1], m.position[2]);
+  p.orientation = Eigen::Quaterniond(m.orientation[0], m.orientation[1], m.orientation[2], m.orientation[3]);
+  p.valid = m.valid;
+  pose_input_.on_external_pose(p);
 }
 
 void SweepProcessor::flush(SweepSink& sink) {

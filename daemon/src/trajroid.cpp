@@ -10,6 +10,7 @@
 #include <thread>
 #include <vector>
 
+#include "lcm_pose_input.hpp"
 #include "log.hpp"
 #include "outlet.hpp"
 #include "pipeline.hpp"
@@ -57,8 +58,17 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
     pipeline.add_input(std::make_unique<inputs::SerialInput>(name, stream, o), config.buffers.serial_chunks,
                        std::string("trajroid-") + name, thread);
   };
-  add_serial(config.gnss, "gnss", inputs::Stream::kGnss, config.realtime.gnss);
-  add_serial(config.imu, "imu", inputs::Stream::kImu, config.realtime.imu);
+  // What the pose source reads (a device configured for an unused stream is left closed).
+  if (config.pose_source == PoseSource::kGnssImu || config.pose_source == PoseSource::kGnss) {
+    add_serial(config.gnss, "gnss", inputs::Stream::kGnss, config.realtime.gnss);
+  }
+  if (config.pose_source == PoseSource::kGnssImu)
+    add_serial(config.imu, "imu", inputs::Stream::kImu, config.realtime.imu);
+  if (config.pose_source == PoseSource::kLcm) {
+    pipeline.add_input(std::make_unique<LcmPoseInput>(options.lcm_url.empty() ? config.lcm.url : options.lcm_url,
+                                                      config.lcm.pose_input),
+                       config.buffers.serial_chunks, "trajroid-posein", config.realtime.gnss);
+  }
 }
 
 // Signals go to the main thread only, through a signalfd (-1 when not handled).

@@ -62,10 +62,9 @@ inline std::vector<std::uint32_t> filter_keeps(const trajroi::vlp16::Frame& fram
   std::snprintf(chain, sizeof chain,
                 " --shape circular --diameter %.17g --spacing %.17g --start-s %.17g --look-ahead %.17g",
                 2.0 * roi.radius_m, roi.spacing_m, roi.start_s_m, roi.look_ahead_m);
-  const std::string cmd = std::string(TRAJROI_CLI) + " filter --trajectory " +
-                          trajectory.string() + " --points " + points.string() + " --pose " +
-                          pose + chain + " --cloud-precision float --output-indices " + indices.string() +
-                          " 2>/dev/null";
+  const std::string cmd = std::string(TRAJROI_CLI) + " filter --trajectory " + trajectory.string() + " --points " +
+                          points.string() + " --pose " + pose + chain + " --cloud-precision float --output-indices " +
+                          indices.string() + " 2>/dev/null";
   EXPECT_EQ(run_command(cmd), 0) << cmd;
   std::vector<std::uint32_t> kept;
   std::istringstream in(slurp(indices));

@@ -6,16 +6,22 @@
 // through the u-blox fix. Published sweeps must come with a valid pose within 10 s, and their
 // kept points must be exactly what `trajroi filter` keeps of the same sweep (decoded here from
 // the pcap) placed with the same published pose. Once per pose source: gnss_imu, gnss (the
-// receiver is parked: the configured initial heading, held), fixed (LiDAR alone).
+// receiver is parked: the configured initial heading, held), lcm (a test publisher stands in
+// for the robot's localization: pose_input_t at 20 Hz, UTC stamps, latitude/longitude), fixed
+// (LiDAR alone).
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <thread>
 
 #include "daemon_fixture.hpp"
 #include "filter_check.hpp"
 #include "test_data.hpp"
+#include "trajroi/inputs/input_source.hpp"
 #include "trajroi/pose/geodetic.hpp"
+#include "trajroi/pose_input_t.hpp"
 
 namespace {
 
@@ -67,7 +73,7 @@ struct Rig {
                        "lidar:\n  data_port: " +
                        std::to_string(data_port) + "\n  position_port: " + std::to_string(data_port + 1) +
                        "\n  min_range_m: 0.5\n  max_range_m: 60\n";
-    if (source != "fixed") text += "gnss:\n  device: " + gnss_link.string() + "\n";
+    if (source == "gnss_imu" || source == "gnss") text += "gnss:\n  device: " + gnss_link.string() + "\n";
     if (source == "gnss_imu") text += "imu:\n  device: " + imu_link.string() + "\n";
     text += "pose:\n  source: " + source + "\n  mode: per_sweep\n";
     // Parked receiver: no course over ground; the robot faces north-east until it moves.
@@ -75,7 +81,8 @@ struct Rig {
     if (source == "fixed") text += "  fixed: {xyz: [3.3, 2.0, 0.5], yaw_deg: 60}\n";
     text += "roi:\n  circle_diameter_m: 1.2\n  look_ahead_m: 6\n";
     text += "lcm:\n  channels: {points: " + prefix + "_POINTS, pose: " + prefix + "_POSE, roi: " + prefix +
-            "_ROI, status: " + prefix + "_STATUS, trajectory: " + prefix + "_TRAJECTORY}\n";
+            "_ROI, status: " + prefix + "_STATUS, trajectory: " + prefix + "_TRAJECTORY, pose_input: " + prefix +
+            "_POSE_INPUT}\n";
     config = dir / "trajroid.yaml";
     std::ofstream(config) << text;
   }
@@ -96,7 +103,11 @@ TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKee
   TRAJROI_REQUIRE_DATA(ubx, kUbx);
   TRAJROI_REQUIRE_DATA(vn100, kVn100);
   const std::string source = GetParam();
-  const Rig rig(source, source, source == std::string("gnss_imu") ? 0 : source == std::string("gnss") ? 1 : 2);
+  const int port_offset = source == std::string("gnss_imu") ? 0
+                          : source == std::string("gnss")   ? 1
+                          : source == std::string("lcm")    ? 2
+                                                            : 3;
+  const Rig rig(source, source, port_offset);
   Listener listener(rig.prefix);
   ASSERT_TRUE(listener.good());
   Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
@@ -114,7 +125,7 @@ TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKee
                                 "5",
                                 "--linger",
                                 "2"};
-  if (source != std::string("fixed")) {
+  if (source == std::string("gnss_imu") || source == std::string("gnss")) {
     feed.insert(feed.end(), {"--ubx", ubx.string(), "--gnss-link", rig.gnss_link.string()});
   }
   if (source == std::string("gnss_imu")) {
@@ -122,12 +133,45 @@ TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKee
   }
   const auto feed_start = std::chrono::steady_clock::now();
   Child feeder(TRAJROI_CLI, feed, rig.feed_log);
+  // The localization: the receiver's fix, facing 45° (north-east), stamped in UTC.
+  std::atomic<bool> stop_localization{false};
+  std::thread localization;
+  if (source == std::string("lcm")) {
+    localization = std::thread([&] {
+      lcm::LCM lcm(kTestLcmUrl);
+      trajroi::pose_input_t m;
+      m.clock = trajroi::pose_input_t::STAMP_UTC;
+      m.frame = trajroi::pose_input_t::LAT_LON;
+      m.position[0] = 50.1350851;
+      m.position[1] = 14.4299466;
+      m.position[2] = 348.86;
+      const Eigen::Quaterniond q(Eigen::AngleAxisd(M_PI / 4.0, Eigen::Vector3d::UnitZ()));
+      m.orientation[0] = q.w();
+      m.orientation[1] = q.x();
+      m.orientation[2] = q.y();
+      m.orientation[3] = q.z();
+      m.valid = true;
+      while (!stop_localization) {
+        m.t_ns = trajroi::inputs::realtime_ns();
+        lcm.publish(rig.prefix + "_POSE_INPUT", &m);
+        std::this_thread::sleep_for(milliseconds(50));
+      }
+    });
+  }
+  struct Joiner {
+    std::atomic<bool>& stop;
+    std::thread& thread;
+    ~Joiner() {
+      stop = true;
+      if (thread.joinable()) thread.join();
+    }
+  } joiner{stop_localization, localization};
 
   // The first published sweep, with its valid pose, within 10 s of the sensors starting.
   ASSERT_TRUE(listener.wait_for([&] { return !listener.points.empty(); }, seconds(10))) << rig.logs();
   const double first_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - feed_start).count();
-  std::printf("[ real captures ] pose source %s: first sweep published %.2f s after the feed started\n",
-              source.c_str(), first_s);
+  std::printf("[ real captures ] pose source %s: first sweep published %.2f s after the feed started\n", source.c_str(),
+              first_s);
 
   ASSERT_EQ(feeder.wait(seconds(60)), 0) << rig.logs();
   std::this_thread::sleep_for(milliseconds(300));
@@ -145,6 +189,7 @@ TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKee
     EXPECT_EQ(m.points_in, static_cast<std::int32_t>(frame.points.size())) << "sweep " << frame.index;
     const std::string expected_heading = source == std::string("gnss_imu") ? "imu"
                                          : source == std::string("gnss")   ? "configured initial heading"
+                                         : source == std::string("lcm")    ? "localization"
                                                                            : "fixed";
     EXPECT_EQ(m.pose.heading_source, expected_heading);
     const auto expected = filter_keeps(frame, m, listener.rois.at(m.sweep_index), rig.dir, rig.trajectory_xy);
@@ -169,7 +214,7 @@ TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKee
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(PoseSources, RealCaptures, testing::Values("gnss_imu", "gnss", "fixed"),
+INSTANTIATE_TEST_SUITE_P(PoseSources, RealCaptures, testing::Values("gnss_imu", "gnss", "lcm", "fixed"),
                          [](const testing::TestParamInfo<const char*>& p) { return std::string(p.param); });
 
 }  // namespace

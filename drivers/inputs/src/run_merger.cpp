@@ -26,9 +26,12 @@ RunMerger::RunMerger(const fs::path& dir, RunStreams streams, std::int64_t shift
   };
   gnss_ = open_serial(streams.gnss, kGnssFile);
   imu_ = open_serial(streams.imu, kImuFile);
+  // Only runs recorded with pose.source lcm have one: not missing when absent.
+  if (fs::exists(dir / kPoseFile)) pose_ = std::make_unique<serial::ReplaySource>((dir / kPoseFile).string());
   fill_lidar();
   fill_serial(gnss_.get(), gnss_next_, Stream::kGnss);
   fill_serial(imu_.get(), imu_next_, Stream::kImu);
+  fill_serial(pose_.get(), pose_next_, Stream::kPose);
 }
 
 RunMerger::~RunMerger() = default;
@@ -67,7 +70,7 @@ void RunMerger::fill_serial(serial::ReplaySource* source, Pending& p, Stream str
 
 RunMerger::Pending* RunMerger::earliest() noexcept {
   Pending* p = nullptr;
-  for (Pending* c : {&gnss_next_, &imu_next_, &lidar_}) {
+  for (Pending* c : {&gnss_next_, &imu_next_, &pose_next_, &lidar_}) {
     if (c->have && (p == nullptr || c->t < p->t)) p = c;
   }
   return p;
@@ -93,6 +96,8 @@ bool RunMerger::next(InputItem& item) {
     fill_lidar();
   } else if (p == &gnss_next_) {
     fill_serial(gnss_.get(), gnss_next_, Stream::kGnss);
+  } else if (p == &pose_next_) {
+    fill_serial(pose_.get(), pose_next_, Stream::kPose);
   } else {
     fill_serial(imu_.get(), imu_next_, Stream::kImu);
   }

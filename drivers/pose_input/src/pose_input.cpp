@@ -32,6 +32,8 @@ std::string_view to_string(HeadingSource source) noexcept {
       return "held (last GNSS heading)";
     case HeadingSource::kConfigured:
       return "configured initial heading";
+    case HeadingSource::kLocalization:
+      return "localization";
   }
   return "unknown";
 }
@@ -165,6 +167,38 @@ bool PoseInput::add_attitude(const Eigen::Quaterniond& global_from_robot, std::i
   }
   ++counters_.refused;
   return false;
+}
+
+void PoseInput::on_external_pose(const ExternalPose& p) {
+  if (!p.valid || !p.position.allFinite() || !p.orientation.coeffs().allFinite() || p.orientation.norm() < 0.5) {
+    ++counters_.external_invalid;
+    return;
+  }
+  pose::GnssFix fix;
+  fix.t_ns = p.t_ns;
+  fix.quality.fix_type = 3;
+  fix.quality.gnss_fix_ok = true;
+  fix.quality.h_acc_m = 0.0;
+  fix.quality.rtk_fixed = true;
+  Eigen::Quaterniond orientation = p.orientation.normalized();
+  if (p.lat_lon) {
+    const pose::Geodetic where{p.position.x(), p.position.y(), p.position.z()};
+    try {
+      fix.antenna_global_m = frame_.to_global(where);
+    } catch (const std::exception&) {
+      ++counters_.external_invalid;
+      return;
+    }
+    orientation = Eigen::Quaterniond(frame_.global_from_local_enu(where)) * orientation;
+  } else {
+    fix.antenna_global_m = p.position;
+  }
+  if (!buffer_.add_fix(fix)) {
+    ++counters_.refused;
+    return;
+  }
+  ++counters_.external_poses;
+  if (add_attitude(orientation, p.t_ns)) heading_source_ = HeadingSource::kLocalization;
 }
 
 void PoseInput::on_vn100(const vn100::Sample& s, std::int64_t receive_ns) {

@@ -189,6 +189,9 @@ void run_pipelines(const ScenarioRun& run, std::span<const daemon::DaemonConfig>
         case inputs::Stream::kImu:
           p.imu_bytes(item.bytes, item.receive_ns);
           break;
+        case inputs::Stream::kPose:
+          p.pose_message(item.bytes, item.receive_ns);
+          break;
         case inputs::Stream::kLidarData:
         case inputs::Stream::kLidarPosition: {
           lane.packet_start = std::chrono::steady_clock::now();

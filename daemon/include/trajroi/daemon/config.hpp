@@ -30,6 +30,7 @@ enum class TrajectoryCoordinates : std::uint8_t { kGlobalXy, kLatLon };
 enum class PoseSource : std::uint8_t {
   kGnssImu,  // u-blox position + VN-100 attitude
   kGnss,     // u-blox alone: heading from the course over ground or a moving-base baseline
+  kLcm,      // the robot's localization publishes pose_input_t (lcm.channels.pose_input)
   kFixed,    // a static pose from the configuration
 };
 [[nodiscard]] std::string_view to_string(PoseSource source) noexcept;
@@ -115,6 +116,7 @@ struct DaemonConfig {
     std::string roi = "TRAJROI_ROI";
     std::string status = "TRAJROI_STATUS";
     std::string trajectory = "TRAJROI_TRAJECTORY";
+    std::string pose_input = "TRAJROI_POSE_INPUT";  // pose.source lcm
   } lcm;
 
   struct Buffers {

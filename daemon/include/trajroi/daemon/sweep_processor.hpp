@@ -122,7 +122,8 @@ struct ProcessorCounters {
   std::uint64_t points_kept = 0;
   std::uint64_t points_truncated = 0;
   std::uint64_t trajectory_swaps = 0;
-  std::uint64_t projection_reacquired = 0;  // the robot far from where progress along the trajectory put it
+  std::uint64_t projection_reacquired = 0;    // the robot far from where progress along the trajectory put it
+  std::uint64_t pose_messages_malformed = 0;  // pose_input_t that did not decode, or unknown clock / frame
 };
 
 // How the configuration sets up the pose input (IMU mounting and declination, the delays).
@@ -140,6 +141,10 @@ class SweepProcessor {
   void imu_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) {
     pose_input_.imu_bytes(bytes, receive_ns);
   }
+  // A pose_input_t from the robot's localization (pose.source lcm) as its input hands it over:
+  // 8 bytes of (CLOCK_REALTIME − CLOCK_MONOTONIC) at its receipt, little-endian, then the LCM
+  // message. A message that does not decode is counted.
+  void pose_message(std::span<const std::uint8_t> bytes, std::int64_t receive_ns);
   // Steady-clock time the next datagram entered the daemon: a sweep keeps that of the last
   // datagram that gave it points (for the latency figures; no effect on the output).
   void set_input_arrival(std::int64_t steady_ns) noexcept { arrival_ns_ = steady_ns; }

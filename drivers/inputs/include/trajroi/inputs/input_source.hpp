@@ -18,8 +18,9 @@ enum class Stream : std::uint8_t {
   kLidarPosition,  // a VLP-16 position packet (UDP 8308)
   kGnss,           // bytes from the GNSS receiver (u-blox UBX)
   kImu,            // bytes from the IMU (VN-100 binary)
+  kPose,           // a pose from the robot's localization (pose_input_t, with its clock offset)
 };
-inline constexpr std::size_t kStreamCount = 4;
+inline constexpr std::size_t kStreamCount = 5;
 [[nodiscard]] constexpr bool is_lidar(Stream s) noexcept {
   return s == Stream::kLidarData || s == Stream::kLidarPosition;
 }

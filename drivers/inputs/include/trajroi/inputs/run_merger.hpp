@@ -1,9 +1,9 @@
 #pragma once
 
 // The one merger: a run folder's recordings — lidar.pcap (data and position packets),
-// gnss.trjb and imu.trjb — read as one stream of items in recorded receive-time order (ties:
-// GNSS, then IMU, then LiDAR, so a pose sample recorded with a packet is known before it).
-// The same order on every run: what makes a replay exact.
+// gnss.trjb and imu.trjb, and pose.trjb when there is one — read as one stream of items in recorded receive-time order
+// (ties: GNSS, then IMU, then LiDAR, so a pose sample recorded with a packet is known before it). The same order on
+// every run: what makes a replay exact.
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -24,6 +24,7 @@ namespace trajroi::inputs {
 inline constexpr const char* kLidarFile = "lidar.pcap";
 inline constexpr const char* kGnssFile = "gnss.trjb";
 inline constexpr const char* kImuFile = "imu.trjb";
+inline constexpr const char* kPoseFile = "pose.trjb";  // pose.source lcm: the localization's messages
 
 struct RunStreams {
   bool lidar = true, gnss = true, imu = true;
@@ -65,9 +66,9 @@ class RunMerger {
   [[nodiscard]] Pending* earliest() noexcept;
 
   std::unique_ptr<vlp16::PcapSource> pcap_;
-  std::unique_ptr<serial::ReplaySource> gnss_, imu_;
+  std::unique_ptr<serial::ReplaySource> gnss_, imu_, pose_;
   std::int64_t shift_ns_;
-  Pending lidar_, gnss_next_, imu_next_;
+  Pending lidar_, gnss_next_, imu_next_, pose_next_;
   std::vector<std::uint8_t> out_;  // the item handed out
   std::vector<std::string> missing_;
   std::string error_;

@@ -56,12 +56,13 @@ class ClockMap {
 enum class AttitudeFrom : std::uint8_t { kImu, kGnss };
 
 enum class HeadingSource : std::uint8_t {
-  kNone,        // no attitude yet
-  kImu,         // the VN-100's attitude
-  kBaseline,    // NAV-RELPOSNED moving-base heading
-  kCourse,      // NAV-PVT course over ground
-  kHeld,        // the last GNSS heading, held while neither is usable (slow, or no baseline)
-  kConfigured,  // the configured initial heading, before the GNSS gave one
+  kNone,          // no attitude yet
+  kImu,           // the VN-100's attitude
+  kBaseline,      // NAV-RELPOSNED moving-base heading
+  kCourse,        // NAV-PVT course over ground
+  kHeld,          // the last GNSS heading, held while neither is usable (slow, or no baseline)
+  kConfigured,    // the configured initial heading, before the GNSS gave one
+  kLocalization,  // the robot's localization (pose.source lcm)
 };
 [[nodiscard]] std::string_view to_string(HeadingSource source) noexcept;
 
@@ -85,6 +86,17 @@ struct PoseInputCounters {
   std::uint64_t gnss_headings = 0;         // attitudes made from the GNSS (course, baseline, held)
   std::uint64_t ubx_other = 0;             // well-formed UBX messages not used (neither PVT nor HPPOSLLH / RELPOSNED)
   std::uint64_t refused = 0;               // samples the buffer refused (order, non-finite)
+  std::uint64_t external_poses = 0;        // localization poses used (pose.source lcm)
+  std::uint64_t external_invalid = 0;      // … flagged invalid by the localizer, or off the frame
+};
+
+// A pose from the robot's own localization (pose.source lcm), already on the host clock.
+struct ExternalPose {
+  std::int64_t t_ns = 0;
+  bool lat_lon = false;                                             // position is lat_deg, lon_deg, height_m
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();               // global frame m, or geodetic
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // global_from_robot (ENU at the robot)
+  bool valid = false;
 };
 
 class PoseInput {
@@ -96,6 +108,9 @@ class PoseInput {
   // Already framed and decoded (for callers that frame themselves).
   void on_ubx(const ublox::Message& message, std::int64_t receive_ns);
   void on_vn100(const vn100::Sample& sample, std::int64_t receive_ns);
+  // A localization pose: its position as a fix that passes every gate (the localizer vouches
+  // for it), its orientation as an attitude. Invalid ones are counted, not used.
+  void on_external_pose(const ExternalPose& pose);
 
   [[nodiscard]] const PoseInputCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const framing::FramerCounters& gnss_framing() const noexcept { return ubx_.counters(); }

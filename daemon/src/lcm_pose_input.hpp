@@ -1,0 +1,39 @@
+#pragma once
+
+// pose.source lcm: the robot's localization publishes pose_input_t; this input hears it on its
+// own LCM instance and hands each message to the pipeline as an item (Stream::kPose) prefixed
+// with the host's (CLOCK_REALTIME − CLOCK_MONOTONIC) at its receipt, so a UTC stamp is placed
+// on the monotonic clock exactly as it was live, in a replay of the recording too.
+#include <cstdint>
+#include <deque>
+#include <lcm/lcm-cpp.hpp>
+#include <string>
+#include <vector>
+
+#include "trajroi/inputs/input_source.hpp"
+
+namespace trajroi::daemon {
+
+class LcmPoseInput final : public inputs::InputSource {
+ public:
+  // Throws std::runtime_error when the LCM URL cannot be opened.
+  LcmPoseInput(const std::string& url, std::string channel);
+
+  Next next(inputs::InputItem& item, std::chrono::milliseconds timeout) override;
+  [[nodiscard]] const inputs::Notice& notice() const noexcept override { return notice_; }
+  [[nodiscard]] const std::string& error() const noexcept override { return error_; }
+  [[nodiscard]] inputs::InputCounters counters() const noexcept override;
+  [[nodiscard]] std::string describe() const override { return "LCM " + channel_ + " (pose_input_t)"; }
+
+ private:
+  static constexpr std::size_t kMaxQueued = 64;  // a burst beyond this between two reads: oldest dropped
+  std::string channel_;
+  lcm::LCM lcm_;
+  std::deque<std::vector<std::uint8_t>> queued_;
+  std::vector<std::uint8_t> current_;
+  inputs::Notice notice_;
+  std::string error_;
+  std::uint64_t items_ = 0, errors_ = 0, oversize_ = 0;
+};
+
+}  // namespace trajroi::daemon
