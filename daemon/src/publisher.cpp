@@ -1,6 +1,7 @@
 #include "publisher.hpp"
 
 #include <poll.h>
+#include <systemd/sd-daemon.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -42,6 +43,7 @@ Publisher::Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, boo
       config_(pipeline.config),
       frame_(pose::GlobalFrame::local_cartesian(pipeline.config.origin)),
       start_steady_ns_(steady_ns()),
+      health_(pipeline.config, !replay, start_steady_ns_),
       sweep_warn_limit_(pipeline.config.logging.warning_interval_s),
       trajectory_warn_limit_(pipeline.config.logging.warning_interval_s) {}
 
@@ -173,6 +175,15 @@ void Publisher::publish_status(const StatusSnapshot& s) {
       m.sweeps, m.sweeps_published, m.sweeps_without_pose, m.points_in, m.points_kept, kept_pct, m.latency_ms_p50,
       m.latency_ms_p99, m.ring_drops, m.lost_packets, m.pose_status, static_cast<int>(m.fix_type), m.pose_age_s,
       m.trajectory_id);
+  // Faults said when they start and end; systemd told the state in words.
+  for (const HealthLine& line : health_.update(s)) {
+    if (line.level == HealthLine::Level::kWarning) {
+      log::warn("{}", line.text);
+    } else {
+      log::info("{}", line.text);
+    }
+  }
+  if (!s.final) sd_notify(0, ("STATUS=" + health_.state()).c_str());
   latency_window_ms_.clear();
   processing_window_ms_.clear();
   last_status_ = s;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "health.hpp"
 #include "log.hpp"
 #include "outlet.hpp"
 #include "pipeline.hpp"
@@ -58,6 +59,7 @@ class Publisher {
   StatusSnapshot minute_start_;  // the status at the start of the current minute
   StatusSnapshot last_status_;
   std::int64_t start_steady_ns_;
+  HealthMonitor health_;
   log::RateLimited sweep_warn_limit_;       // withheld sweeps
   log::RateLimited trajectory_warn_limit_;  // rejected trajectory messages: never hidden by the above
 };

@@ -67,6 +67,8 @@ struct Names {
     set(C::kPoseImuReceiveStamped, "pose.imu_receive_stamped");
     set(C::kPoseGnssHeadings, "pose.gnss_headings");
     set(C::kPoseUbxOther, "pose.ubx_other_messages");
+    set(C::kGnssForeignFrames, "gnss.vn100_frames");
+    set(C::kImuForeignFrames, "imu.ubx_frames");
     set(C::kPoseExternal, "pose.localization_poses");
     set(C::kPoseExternalInvalid, "pose.localization_invalid");
     set(C::kPoseMessagesMalformed, "pose.localization_malformed");
@@ -118,6 +120,11 @@ void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64
   s.pose_age_s = fix != nullptr ? std::max(0.0, static_cast<double>(last_receive_ns - fix->t_ns) * 1e-9) : -1.0;
   s.fix_type = fix != nullptr ? fix->quality.fix_type : 0;
   s.h_acc_m = fix != nullptr ? fix->quality.h_acc_m : 0.0;
+  s.trajectory_distance_m = p.trajectory_distance_m();
+  const std::string& reason = p.lidar_model_reason();
+  const std::size_t n = std::min(reason.size(), s.model_reason.size() - 1);
+  std::copy_n(reason.begin(), n, s.model_reason.begin());
+  s.model_reason[n] = '\0';
 
   s.counters.fill(0);
   for (const auto& lane : pipeline.inputs) {
@@ -172,6 +179,8 @@ void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64
   s[C::kPoseImuReceiveStamped] = pc.imu_receive_stamped;
   s[C::kPoseGnssHeadings] = pc.gnss_headings;
   s[C::kPoseUbxOther] = pc.ubx_other;
+  s[C::kGnssForeignFrames] = pc.vn100_frames_on_gnss;
+  s[C::kImuForeignFrames] = pc.ubx_frames_on_imu;
   s[C::kPoseExternal] = pc.external_poses;
   s[C::kPoseExternalInvalid] = pc.external_invalid;
   s[C::kPoseMessagesMalformed] = p.counters().pose_messages_malformed;

@@ -61,6 +61,8 @@ enum class Counter : std::uint16_t {
   kPoseImuReceiveStamped,
   kPoseGnssHeadings,
   kPoseUbxOther,
+  kGnssForeignFrames,
+  kImuForeignFrames,
   kPoseExternal,
   kPoseExternalInvalid,
   kPoseMessagesMalformed,
@@ -89,6 +91,10 @@ struct StatusSnapshot {
   std::uint8_t fix_type = 0;
   double h_acc_m = 0.0;
   bool final = false;  // the last one: the input has ended
+  // For the fault lines (health.hpp): the robot's distance to the active trajectory at the
+  // last sweep with a pose (NaN before), and the model check's last rejection ("" if none).
+  double trajectory_distance_m = 0.0;
+  std::array<char, 160> model_reason{};
   std::array<std::uint64_t, kCounterCount> counters{};
 
   [[nodiscard]] std::uint64_t& operator[](Counter c) noexcept { return counters[static_cast<std::size_t>(c)]; }

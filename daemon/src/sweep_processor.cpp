@@ -258,6 +258,7 @@ void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
   }
   s_hint_m_ = p.s_m;
   have_hint_ = true;
+  trajectory_distance_m_ = p.distance_m;
   // An unknown speed grows the ROI as the cap does: the larger region is the safe side.
   const double speed = s.speed_known ? std::min(s.speed_mps, r.max_speed_mps) : r.max_speed_mps;
   s.start_s_m = p.s_m;

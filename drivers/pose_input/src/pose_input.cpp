@@ -43,9 +43,16 @@ PoseInput::PoseInput(pose::GlobalFrame frame, const PoseInputConfig& config, pos
 
 void PoseInput::gnss_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) {
   ubx_.feed(bytes, [&](const ublox::Message& m) { on_ubx(m, receive_ns); });
+  // Only while this port has given no UBX frame: a healthy port pays nothing for the check.
+  if (ubx_.counters().frames == 0) {
+    vn_on_gnss_.feed(bytes, [&](std::span<const std::uint8_t>) { ++counters_.vn100_frames_on_gnss; });
+  }
 }
 
 void PoseInput::imu_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) {
+  if (vn_.counters().frames == 0) {
+    ubx_on_imu_.feed(bytes, [&](const ublox::Message&) { ++counters_.ubx_frames_on_imu; });
+  }
   vn_.feed(bytes, [&](std::span<const std::uint8_t> frame) {
     vn100::Sample sample;
     if (vn100::decode(frame, sample)) {

@@ -18,9 +18,11 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "trajroi/daemon/config.hpp"
@@ -164,6 +166,11 @@ class SweepProcessor {
   [[nodiscard]] const vlp16::StreamCounters& lidar_counters() const noexcept { return decoder_.counters(); }
   [[nodiscard]] const pose_input::PoseInput& pose_input() const noexcept { return pose_input_; }
   [[nodiscard]] const pose::PoseBuffer& poses() const noexcept { return poses_; }
+  // The robot's distance to the active trajectory at the last sweep with a pose (NaN before).
+  [[nodiscard]] double trajectory_distance_m() const noexcept { return trajectory_distance_m_; }
+  // Why the last packet rejected for its model was ("product id 0x28 (VLP-32C) is not
+  // supported"), empty if none was.
+  [[nodiscard]] const std::string& lidar_model_reason() const noexcept { return decoder_.model_check().reason(); }
   // The sweep being built (its pose status tells why a sweep is withheld).
   [[nodiscard]] const Sweep& current() const noexcept { return sweep_; }
 
@@ -185,6 +192,7 @@ class SweepProcessor {
   std::unique_ptr<ActiveTrajectory> pending_;
   std::unique_ptr<ActiveTrajectory> retired_;
   double s_hint_m_ = 0.0;
+  double trajectory_distance_m_ = std::numeric_limits<double>::quiet_NaN();
   bool have_hint_ = false;
   std::optional<std::int64_t> valid_since_ns_;  // first sweep start of the current valid run
 

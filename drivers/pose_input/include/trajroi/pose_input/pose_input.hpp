@@ -86,6 +86,8 @@ struct PoseInputCounters {
   std::uint64_t gnss_headings = 0;         // attitudes made from the GNSS (course, baseline, held)
   std::uint64_t ubx_other = 0;             // well-formed UBX messages not used (neither PVT nor HPPOSLLH / RELPOSNED)
   std::uint64_t refused = 0;               // samples the buffer refused (order, non-finite)
+  std::uint64_t vn100_frames_on_gnss = 0;  // VN-100 frames among the GNSS bytes (devices swapped?)
+  std::uint64_t ubx_frames_on_imu = 0;     // UBX frames among the IMU bytes
   std::uint64_t external_poses = 0;        // localization poses used (pose.source lcm)
   std::uint64_t external_invalid = 0;      // … flagged invalid by the localizer, or off the frame
 };
@@ -128,6 +130,9 @@ class PoseInput {
   pose::PoseBuffer& buffer_;
   ublox::Framer ubx_;
   vn100::Framer vn_;
+  // The other sensor's framer on each port, to tell swapped devices from a wrong baud rate.
+  ublox::Framer ubx_on_imu_;
+  vn100::Framer vn_on_gnss_;
   ClockMap gnss_clock_;
   ClockMap imu_clock_;
   std::optional<ublox::NavHpposllh> hp_;

@@ -1,0 +1,196 @@
+// Every fault named: the health monitor turns the status counters' changes into one log line
+// per fault, with its figures, within 5 s of the fault (snapshots once a second), and one when
+// it ends; and tells systemd the state in words. The live tests (live_faults_test.cpp) show
+// the same lines from a running daemon on real bytes.
+#include "health.hpp"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "trajroi/vlp16/packet.hpp"
+
+namespace {
+
+using namespace trajroi::daemon;
+constexpr std::int64_t kSecond = 1'000'000'000;
+
+DaemonConfig live_config() {
+  DaemonConfig c;
+  c.lidar.data_port = 2368;
+  c.lidar.sensor_address = "192.168.1.201";
+  c.gnss.device = "/dev/gnss";
+  c.imu.device = "/dev/imu";
+  return c;
+}
+
+// Runs `seconds` snapshots (one a second from a start at 0), `change` making each; returns
+// every line said, and the second each first came.
+struct Said {
+  std::vector<HealthLine> lines;
+  std::vector<int> at_s;
+  std::string state;
+  [[nodiscard]] int first(const std::string& part) const {
+    for (std::size_t i = 0; i < lines.size(); ++i)
+      if (lines[i].text.find(part) != std::string::npos) return at_s[i];
+    return -1;
+  }
+  [[nodiscard]] std::string all() const {
+    std::string out;
+    for (const auto& l : lines)
+      out += l.text + "\n";
+    return out;
+  }
+};
+
+template <class Change>
+Said run(const DaemonConfig& config, int seconds, Change change, bool live = true) {
+  HealthMonitor monitor(config, live, 0);
+  StatusSnapshot s;
+  s.trajectory_distance_m = std::numeric_limits<double>::quiet_NaN();
+  Said said;
+  for (int t = 1; t <= seconds; ++t) {
+    s.steady_ns = t * kSecond;
+    change(s, t);
+    for (HealthLine& l : monitor.update(s)) {
+      said.lines.push_back(std::move(l));
+      said.at_s.push_back(t);
+    }
+  }
+  said.state = monitor.state();
+  return said;
+}
+
+// A healthy second: a VLP-16's 754 data packets, GNSS and IMU frames, fixes and attitudes.
+void healthy(StatusSnapshot& s, int) {
+  s.lidar_packets += 754;
+  s.position_packets += 1;
+  s[Counter::kGnssBytes] += 1000;
+  s[Counter::kGnssFrames] += 10;
+  s[Counter::kPoseFixes] += 10;
+  s[Counter::kImuBytes] += 5000;
+  s[Counter::kImuFrames] += 40;
+  s[Counter::kPoseAttitudes] += 40;
+  s.processor.sweeps += 10;
+  s.processor.sweeps_filtered += 10;
+  s.pose_valid = true;
+  s.pose_status = trajroi::pose::PoseStatus::kValid;
+}
+
+TEST(Health, AHealthyDaemonSaysNothingAndPublishes) {
+  const Said said = run(live_config(), 10, healthy);
+  EXPECT_TRUE(said.lines.empty()) << said.all();
+  EXPECT_EQ(said.state, "publishing 10.0 sweeps/s");
+}
+
+TEST(Health, NoLidarDatagramsAreNamedWithThePortWithinFiveSecondsAndTheirReturnToo) {
+  const Said said = run(live_config(), 12, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    if (t <= 8) s.lidar_packets -= 754, s.position_packets -= 1;  // nothing until 8 s
+  });
+  const int at = said.first("lidar: no datagrams for 4 s on UDP 0.0.0.0:2368 (data) / 8308 (position)");
+  EXPECT_GE(at, 1) << said.all();
+  EXPECT_LE(at, 5);
+  EXPECT_EQ(said.first("lidar: datagrams arriving on UDP port 2368"), 9) << said.all();
+  // A replay has no sensor to be silent.
+  EXPECT_TRUE(run(live_config(), 8, [](StatusSnapshot&, int) {}, false).lines.empty());
+  // The state while waiting.
+  EXPECT_EQ(run(live_config(), 3, [](StatusSnapshot&, int) {}).state, "waiting for LiDAR data on UDP port 2368");
+}
+
+TEST(Health, DatagramsOnlyFromAnotherSenderNameTheSensorAddress) {
+  const Said said = run(live_config(), 6, [](StatusSnapshot& s, int) { s[Counter::kLidarRejectedSource] += 754; });
+  const int at = said.first("none from sensor_address 192.168.1.201");
+  EXPECT_GE(at, 1) << said.all();
+  EXPECT_LE(at, 5);
+  EXPECT_EQ(said.first("lidar: no datagrams"), -1) << "not silent: they come, from elsewhere";
+}
+
+TEST(Health, AnUnsupportedModelIsNamedWithTheDriversReason) {
+  const Said said = run(live_config(), 3, [](StatusSnapshot& s, int) {
+    s.counters[static_cast<std::size_t>(Counter::kLidarRejected) +
+               static_cast<std::size_t>(trajroi::vlp16::PacketError::kUnsupportedProduct) - 1] += 1800;
+    const std::string reason = "product id 0x21 (HDL-32E) is not supported";
+    reason.copy(s.model_reason.data(), reason.size());
+  });
+  EXPECT_EQ(said.first("lidar: 1800 packets rejected in the last second: product id 0x21 (HDL-32E) is not supported"),
+            1)
+      << said.all();
+}
+
+TEST(Health, BytesButNoFramesSayWrongBaudRateWithTheFigures) {
+  const Said said = run(live_config(), 6, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s[Counter::kGnssFrames] -= 10;
+    s[Counter::kPoseFixes] -= 10;
+  });
+  const int at = said.first("gnss: 4000 bytes in 4 s from /dev/gnss at 115200 baud but no UBX frame: wrong baud rate?");
+  EXPECT_GE(at, 1) << said.all();
+  EXPECT_LE(at, 5);
+}
+
+TEST(Health, FramesOfTheOtherSensorSaySwappedDevices) {
+  const Said said = run(live_config(), 6, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s[Counter::kGnssFrames] -= 10;
+    s[Counter::kPoseFixes] -= 10;
+    s[Counter::kGnssForeignFrames] += 40;
+    s[Counter::kImuFrames] -= 40;
+    s[Counter::kPoseAttitudes] -= 40;
+    s[Counter::kImuForeignFrames] += 10;
+  });
+  EXPECT_LE(said.first("gnss: 160 VN-100 frames (and no UBX frame) in 4 s from /dev/gnss: gnss.device and "
+                       "imu.device swapped?"),
+            5)
+      << said.all();
+  EXPECT_GE(said.first("imu: 40 UBX frames (and no VN-100 frame)"), 1) << said.all();
+}
+
+TEST(Health, ASilentReceiverAndMissingOutputsAreNamed) {
+  Said said = run(live_config(), 6, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s[Counter::kGnssBytes] -= 1000;
+    s[Counter::kGnssFrames] -= 10;
+    s[Counter::kPoseFixes] -= 10;
+  });
+  EXPECT_GE(said.first("gnss: no bytes for 4 s from /dev/gnss"), 1) << said.all();
+  said = run(live_config(), 6, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s[Counter::kPoseFixes] -= 10;  // frames, but none a NAV-PVT
+    s[Counter::kPoseAttitudes] -= 40;
+    s[Counter::kPoseImuWithoutAttitude] += 40;
+  });
+  EXPECT_GE(said.first("gnss: 40 UBX frames in 4 s but no NAV-PVT"), 1) << said.all();
+  EXPECT_GE(said.first("imu: 160 VN-100 frames in 4 s carry no YawPitchRoll, Quaternion or DCM"), 1) << said.all();
+}
+
+TEST(Health, ATrajectoryFarFromTheRobotIsNamedWithTheDistance) {
+  const Said said = run(live_config(), 4, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s.trajectory_id = 7;
+    s.trajectory_distance_m = t < 3 ? 5012.0 : 3.0;
+  });
+  EXPECT_EQ(said.first("trajectory 7: the robot is 5012 m from it (more than 50 m)"), 1) << said.all();
+  EXPECT_EQ(said.first("trajectory 7: the robot is back within 50 m of it"), 3) << said.all();
+}
+
+TEST(Health, ASensorClockJumpIsNamedAsSuchNotAsLoss) {
+  const Said said = run(live_config(), 3, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    if (t == 2) s[Counter::kLidarClockJumps] += 1;
+  });
+  EXPECT_EQ(said.first("lidar: the sensor's clock jumped forward 1 time(s) in the last second"), 2) << said.all();
+}
+
+TEST(Health, TheStateSaysWhyThereIsNoPose) {
+  const Said said = run(live_config(), 3, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s.pose_valid = false;
+    s.pose_status = trajroi::pose::PoseStatus::kNoGnss;
+  });
+  EXPECT_EQ(said.state, "no valid pose: no GNSS fix yet");
+}
+
+}  // namespace
