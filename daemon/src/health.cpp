@@ -66,22 +66,22 @@ std::vector<HealthLine> HealthMonitor::update(const StatusSnapshot& s) {
              "the sensor's?",
              static_cast<unsigned long long>(foreign), window_s, l.data_port, l.sensor_address.c_str()),
       "lidar: datagrams from the sensor_address arriving", out);
-  if (const std::uint64_t n = rejected(vlp16::PacketError::kUnsupportedProduct) -
-                              rejected_before(vlp16::PacketError::kUnsupportedProduct);
+  if (const std::uint64_t n =
+          rejected(vlp16::PacketError::kUnsupportedProduct) - rejected_before(vlp16::PacketError::kUnsupportedProduct);
       n > 0) {
     const std::string reason = s.model_reason.data();
     out.push_back({HealthLine::Level::kWarning,
                    format("lidar: %llu packets rejected in the last second: %s (trajroid decodes the VLP-16 only; "
                           "lidar.rejected.unsupported_product %llu)",
-                          static_cast<unsigned long long>(n),
-                          reason.empty() ? "not a VLP-16" : reason.c_str(),
+                          static_cast<unsigned long long>(n), reason.empty() ? "not a VLP-16" : reason.c_str(),
                           static_cast<unsigned long long>(rejected(vlp16::PacketError::kUnsupportedProduct)))});
   }
   if (const std::uint64_t n = step(C::kLidarClockJumps); n > 0) {
-    out.push_back({HealthLine::Level::kWarning,
-                   format("lidar: the sensor's clock jumped forward %llu time(s) in the last second (a time "
-                          "re-sync?): not counted as lost packets (lidar.clock_jumps %llu)",
-                          static_cast<unsigned long long>(n), static_cast<unsigned long long>(s[C::kLidarClockJumps]))});
+    out.push_back(
+        {HealthLine::Level::kWarning,
+         format("lidar: the sensor's clock jumped forward %llu time(s) in the last second (a time "
+                "re-sync?): not counted as lost packets (lidar.clock_jumps %llu)",
+                static_cast<unsigned long long>(n), static_cast<unsigned long long>(s[C::kLidarClockJumps]))});
   }
 
   // The serial streams the pose source reads.
@@ -99,9 +99,9 @@ std::vector<HealthLine> HealthMonitor::update(const StatusSnapshot& s) {
     const bool garbage = used && judged && delta(bytes) > 0 && delta(frames) == 0;
     std::string why;
     if (delta(foreign_frames) > 0) {
-      why = format("%s: %llu %s frames (and no %s frame) in %.0f s from %s: gnss.device and imu.device swapped?", name,
-                   static_cast<unsigned long long>(delta(foreign_frames)), other, protocol, window_s,
-                   dev.device.c_str());
+      why =
+          format("%s: %llu %s frames (and no %s frame) in %.0f s from %s: gnss.device and imu.device swapped?", name,
+                 static_cast<unsigned long long>(delta(foreign_frames)), other, protocol, window_s, dev.device.c_str());
     } else {
       why = format("%s: %llu bytes in %.0f s from %s at %d baud but no %s frame: wrong baud rate?", name,
                    static_cast<unsigned long long>(delta(bytes)), window_s, dev.device.c_str(), dev.baud, protocol);

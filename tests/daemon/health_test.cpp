@@ -95,7 +95,9 @@ TEST(Health, NoLidarDatagramsAreNamedWithThePortWithinFiveSecondsAndTheirReturnT
   EXPECT_LE(at, 5);
   EXPECT_EQ(said.first("lidar: datagrams arriving on UDP port 2368"), 9) << said.all();
   // A replay has no sensor to be silent.
-  EXPECT_TRUE(run(live_config(), 8, [](StatusSnapshot&, int) {}, false).lines.empty());
+  EXPECT_TRUE(run(
+                  live_config(), 8, [](StatusSnapshot&, int) {}, false)
+                  .lines.empty());
   // The state while waiting.
   EXPECT_EQ(run(live_config(), 3, [](StatusSnapshot&, int) {}).state, "waiting for LiDAR data on UDP port 2368");
 }

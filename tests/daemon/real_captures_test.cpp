@@ -45,12 +45,14 @@ struct Rig {
   fs::path dir, config, gnss_link, imu_link, daemon_log, feed_log, trajectory_xy;
   int data_port = 0;
 
-  Rig(const std::string& name, const std::string& source, int port_offset) {
+  // `lidar_extra`: more lidar keys ("  sensor_address: …\n"); `fixed`: pose.fixed for source fixed.
+  Rig(const std::string& name, const std::string& source, int port_offset, const std::string& lidar_extra = "",
+      const std::string& fixed = "{xyz: [3.3, 2.0, 0.5], yaw_deg: 60}") {
     const int pid = ::getpid();
     prefix = "TRJREAL_" + std::to_string(pid) + "_" + name;
     dir = fs::temp_directory_path() / ("trajroid_real_" + name + "_" + std::to_string(pid));
     fs::create_directories(dir);
-    data_port = 24000 + (pid % 2000) * 8 + port_offset * 2;
+    data_port = 24000 + (pid % 1000) * 32 + port_offset * 2;  // offsets 0 … 15
     gnss_link = dir / "gnss";
     imu_link = dir / "imu";
     daemon_log = dir / "trajroid.log";
@@ -72,13 +74,13 @@ struct Rig {
                        "\ntrajectory:\n  file: trajectory.csv\n"
                        "lidar:\n  data_port: " +
                        std::to_string(data_port) + "\n  position_port: " + std::to_string(data_port + 1) +
-                       "\n  min_range_m: 0.5\n  max_range_m: 60\n";
+                       "\n  min_range_m: 0.5\n  max_range_m: 60\n" + lidar_extra;
     if (source == "gnss_imu" || source == "gnss") text += "gnss:\n  device: " + gnss_link.string() + "\n";
     if (source == "gnss_imu") text += "imu:\n  device: " + imu_link.string() + "\n";
     text += "pose:\n  source: " + source + "\n  mode: per_sweep\n";
     // Parked receiver: no course over ground; the robot faces north-east until it moves.
     if (source == "gnss") text += "  gnss_heading: {initial_heading_deg: 30}\n";
-    if (source == "fixed") text += "  fixed: {xyz: [3.3, 2.0, 0.5], yaw_deg: 60}\n";
+    if (source == "fixed") text += "  fixed: " + fixed + "\n";
     text += "roi:\n  circle_diameter_m: 1.2\n  look_ahead_m: 6\n";
     text += "lcm:\n  channels: {points: " + prefix + "_POINTS, pose: " + prefix + "_POSE, roi: " + prefix +
             "_ROI, status: " + prefix + "_STATUS, trajectory: " + prefix + "_TRAJECTORY, pose_input: " + prefix +
@@ -216,5 +218,148 @@ TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKee
 
 INSTANTIATE_TEST_SUITE_P(PoseSources, RealCaptures, testing::Values("gnss_imu", "gnss", "lcm", "fixed"),
                          [](const testing::TestParamInfo<const char*>& p) { return std::string(p.param); });
+
+// ---- every fault named, live -------------------------------------------------------------
+//
+// The daemon on real bytes (or none) with one thing wrong: the log names it, with its figures,
+// within 5 s.
+
+// Seconds from `start` until `text` appears in the log (-1: not within `timeout`).
+double seconds_until_logged(const fs::path& log, const std::string& text, std::chrono::steady_clock::time_point start,
+                            std::chrono::milliseconds timeout) {
+  const auto until = start + timeout;
+  while (std::chrono::steady_clock::now() < until) {
+    if (slurp(log).find(text) != std::string::npos) {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+    std::this_thread::sleep_for(milliseconds(50));
+  }
+  return -1.0;
+}
+
+#define EXPECT_LOGGED_WITHIN_5S(rig, text, start)                                                    \
+  do {                                                                                               \
+    const double at_s = seconds_until_logged((rig).daemon_log, (text), (start), milliseconds(6000)); \
+    EXPECT_GE(at_s, 0.0) << "not logged: " << (text) << "\n" << (rig).logs();                        \
+    EXPECT_LE(at_s, 5.5) << (text);                                                                  \
+  } while (0)
+
+TEST(LiveFaults, AMissingSerialDeviceAndASilentLidarPortAreNamedWithin5s) {
+  const Rig rig("missing", "gnss_imu", 4);
+  const auto start = std::chrono::steady_clock::now();
+  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
+  EXPECT_LOGGED_WITHIN_5S(rig, "gnss: cannot open " + rig.gnss_link.string() + ": No such file or directory (errno 2)",
+                          start);
+  EXPECT_LOGGED_WITHIN_5S(rig, "imu: cannot open " + rig.imu_link.string() + ": No such file or directory (errno 2)",
+                          start);
+  EXPECT_LOGGED_WITHIN_5S(rig, "lidar: no datagrams for 4 s on UDP 0.0.0.0:" + std::to_string(rig.data_port), start);
+  daemon.signal(SIGTERM);
+  EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+}
+
+TEST(LiveFaults, SwappedSerialDevicesAreNamed) {
+  TRAJROI_REQUIRE_DATA(ubx, kUbx);
+  TRAJROI_REQUIRE_DATA(vn100, kVn100);
+  const Rig rig("swapped", "gnss_imu", 5);
+  const auto start = std::chrono::steady_clock::now();
+  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
+  // The u-blox on the IMU's device, the VN-100 on the GNSS's.
+  Child feeder(TRAJROI_CLI,
+               {"feed", "--ubx", ubx.string(), "--gnss-link", rig.imu_link.string(), "--vn100", vn100.string(),
+                "--imu-link", rig.gnss_link.string(), "--until", "8"},
+               rig.feed_log);
+  EXPECT_LOGGED_WITHIN_5S(
+      rig, "(and no UBX frame) in 4 s from " + rig.gnss_link.string() + ": gnss.device and imu.device swapped?", start);
+  EXPECT_LOGGED_WITHIN_5S(rig, "UBX frames (and no VN-100 frame) in 4 s from " + rig.imu_link.string(), start);
+  daemon.signal(SIGTERM);
+  EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+}
+
+TEST(LiveFaults, BytesThatNeverFrameSayWrongBaudRate) {
+  const Rig rig("baud", "gnss", 6);
+  // What a receiver at another baud rate looks like: bytes, never a frame.
+  const fs::path noise = rig.dir / "noise.bin";
+  {
+    std::ofstream out(noise, std::ios::binary);
+    std::uint32_t x = 12345;
+    for (int i = 0; i < 40000; ++i) {
+      x = x * 1664525u + 1013904223u;
+      out.put(static_cast<char>(x >> 24));
+    }
+  }
+  const auto start = std::chrono::steady_clock::now();
+  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
+  Child feeder(
+      TRAJROI_CLI,
+      {"feed", "--vn100", noise.string(), "--imu-link", rig.gnss_link.string(), "--vn100-rate", "200", "--until", "8"},
+      rig.feed_log);
+  EXPECT_LOGGED_WITHIN_5S(rig, "from " + rig.gnss_link.string() + " at 115200 baud but no UBX frame: wrong baud rate?",
+                          start);
+  daemon.signal(SIGTERM);
+  EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+}
+
+TEST(LiveFaults, AnotherLidarModelIsNamedWithTheDriversReason) {
+  TRAJROI_REQUIRE_DATA(hdl32e, "velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap");
+  const Rig rig("model", "fixed", 7);
+  const auto start = std::chrono::steady_clock::now();
+  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
+  Child feeder(TRAJROI_CLI,
+               {"feed", "--pcap", hdl32e.string(), "--data-port", std::to_string(rig.data_port), "--position-port",
+                std::to_string(rig.data_port + 1), "--lidar-after", "0.5"},
+               rig.feed_log);
+  EXPECT_LOGGED_WITHIN_5S(rig, "(HDL-32E) is not supported", start);
+  EXPECT_LOGGED_WITHIN_5S(rig, "trajroid decodes the VLP-16 only", start);
+  daemon.signal(SIGTERM);
+  EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+}
+
+TEST(LiveFaults, DatagramsFromAnotherAddressNameTheSensorAddress) {
+  TRAJROI_REQUIRE_DATA(pcap, kPcap);
+  const Rig rig("sender", "fixed", 8, "  sensor_address: 127.0.0.2\n");
+  const auto start = std::chrono::steady_clock::now();
+  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
+  Child feeder(TRAJROI_CLI,
+               {"feed", "--pcap", pcap.string(), "--data-port", std::to_string(rig.data_port), "--position-port",
+                std::to_string(rig.data_port + 1), "--lidar-after", "1", "--from", "127.0.0.1"},
+               rig.feed_log);
+  EXPECT_LOGGED_WITHIN_5S(rig, "none from sensor_address 127.0.0.2: is lidar.sensor_address the sensor's?", start);
+  daemon.signal(SIGTERM);
+  EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+}
+
+TEST(LiveFaults, ATrajectoryFarFromTheRobotIsNamedWithItsDistance) {
+  TRAJROI_REQUIRE_DATA(pcap, kPcap);
+  const Rig rig("far", "fixed", 9, "", "{xyz: [5000, 0, 0]}");
+  const auto start = std::chrono::steady_clock::now();
+  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
+  Child feeder(TRAJROI_CLI,
+               {"feed", "--pcap", pcap.string(), "--data-port", std::to_string(rig.data_port), "--position-port",
+                std::to_string(rig.data_port + 1), "--lidar-after", "0.5"},
+               rig.feed_log);
+  EXPECT_LOGGED_WITHIN_5S(rig, "trajectory 0: the robot is 4996 m from it (more than 50 m)", start);
+  daemon.signal(SIGTERM);
+  EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+}
+
+// The sensor's port is this daemon's alone: a second one on it stops at start, naming it.
+TEST(LiveFaults, ASecondDaemonOnTheSameLidarPortFailsAtStartNamingThePort) {
+  const Rig rig("exclusive", "fixed", 10);
+  Child first({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
+  ASSERT_GE(seconds_until_logged(rig.daemon_log, "trajroid running", std::chrono::steady_clock::now(), seconds(5)), 0.0)
+      << rig.logs();
+  const fs::path second_log = rig.dir / "second.log";
+  Child second({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, second_log);
+  const int code = second.wait(seconds(5));
+  EXPECT_NE(code, 0);
+  EXPECT_NE(code, -1) << "the second daemon did not stop";
+  const std::string said = slurp(second_log);
+  EXPECT_NE(said.find("UDP 0.0.0.0:" + std::to_string(rig.data_port) + ": bind: Address already in use"),
+            std::string::npos)
+      << said;
+  EXPECT_TRUE(first.running()) << "the first daemon goes on";
+  first.signal(SIGTERM);
+  EXPECT_EQ(first.wait(seconds(5)), 0) << rig.logs();
+}
 
 }  // namespace
