@@ -313,6 +313,11 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
     b.finish();
   }
   {
+    MapReader t = r.map("time", true);
+    c.time.max_gnss_offset_s = t.positive("max_gnss_offset_s", c.time.max_gnss_offset_s);
+    t.finish();
+  }
+  {
     MapReader l = r.map("logging", true);
     c.logging.level = l.choice("level", {"trace", "debug", "info", "warn", "error", "critical", "off"}, "info");
     c.logging.warning_interval_s = l.non_negative("warning_interval_s", 5.0);
@@ -454,6 +459,7 @@ std::string describe(const DaemonConfig& c) {
   num("buffers.serial_chunks", static_cast<double>(c.buffers.serial_chunks));
   num("buffers.sweeps", static_cast<double>(c.buffers.sweeps));
   num("buffers.max_points_per_sweep", static_cast<double>(c.buffers.max_points_per_sweep));
+  num("time.max_gnss_offset_s", c.time.max_gnss_offset_s);
   line("logging.level", c.logging.level);
   num("logging.warning_interval_s", c.logging.warning_interval_s);
   flag("realtime.lock_memory", c.realtime.lock_memory);

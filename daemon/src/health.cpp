@@ -131,6 +131,14 @@ std::vector<HealthLine> HealthMonitor::update(const StatusSnapshot& s) {
              s.trajectory_id, s.trajectory_distance_m, far_m),
       format("trajectory %d: the robot is back within %.0f m of it", s.trajectory_id, far_m), out);
 
+  // The host clock against GNSS time (live: in a replay the recording's receiver is not now).
+  const double offset = s.host_minus_gnss_utc_s;
+  set(kClockOffset, live_ && std::isfinite(offset) && std::abs(offset) > config_.time.max_gnss_offset_s,
+      format("time: the host clock is %.3f s %s GNSS UTC (more than time.max_gnss_offset_s %.3f s): is NTP/chrony "
+             "running and synchronised?",
+             std::abs(offset), offset > 0 ? "ahead of" : "behind", config_.time.max_gnss_offset_s),
+      format("time: the host clock is within %.3f s of GNSS UTC", config_.time.max_gnss_offset_s), out);
+
   // The state in words.
   const double since_s = static_cast<double>(s.steady_ns - previous.steady_ns) * 1e-9;
   const auto published = s.processor.sweeps_filtered - previous.processor.sweeps_filtered;

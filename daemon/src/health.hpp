@@ -44,6 +44,7 @@ class HealthMonitor {
     kImuNoFrames,
     kImuNoAttitude,
     kTrajectoryFar,
+    kClockOffset,
     kFaultCount
   };
   // Raises or clears `fault`: true → the warning (once, as it starts); false → the info line

@@ -31,6 +31,8 @@ void fill_pose(const Sweep& sweep, trajroi::pose_t& out) {
   out.status = static_cast<std::int8_t>(sweep.pose_status);
   out.status_text = pose::describe(sweep.pose_status, sweep.pose_measured, sweep.pose_limit);
   out.heading_source = std::string(sweep.heading_source);
+  out.utc_ns = sweep.start_utc_ns;
+  out.time_source = std::string(sweep.time_source);
   set_pose(sweep.robot, out.position_m, out.orientation);
   out.yaw_rad = out.valid ? pose::roll_pitch_yaw(sweep.robot.orientation).yaw_rad : 0.0;
   out.speed_mps = sweep.speed_mps;
@@ -43,6 +45,8 @@ void fill_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& out) {
   out.sweep_index = static_cast<std::int64_t>(sweep.index);
   out.sweep_start_ns = sweep.start_ns;
   out.sweep_end_ns = sweep.end_ns;
+  out.sweep_start_utc_ns = sweep.start_utc_ns;
+  out.time_source = std::string(sweep.time_source);
   out.trajectory_id = sweep.trajectory_id;
   out.pose_mode = mode == PoseMode::kPerSweep ? trajroi::points_t::POSE_PER_SWEEP : trajroi::points_t::POSE_PER_FIRING;
   out.return_mode = static_cast<std::int8_t>(sweep.return_mode);

@@ -124,6 +124,7 @@ class Processing {
 
   void run(const ProcessingOptions& options) {
     std::int64_t next_status = steady_ns() + kSecond_ns;
+    if (options.live) processor_.set_host_utc_offset(inputs::realtime_ns() - inputs::monotonic_ns());
     const std::int64_t stall_at = options.stall_after_s
                                       ? steady_ns() + static_cast<std::int64_t>(*options.stall_after_s * 1e9)
                                       : std::numeric_limits<std::int64_t>::max();
@@ -148,6 +149,7 @@ class Processing {
 
       const std::int64_t now = steady_ns();
       if (now >= next_status) {
+        if (options.live) processor_.set_host_utc_offset(inputs::realtime_ns() - inputs::monotonic_ns());
         snapshot(false);
         next_status += kSecond_ns;
         if (next_status < now) next_status = now + kSecond_ns;

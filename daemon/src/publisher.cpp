@@ -148,6 +148,9 @@ void Publisher::publish_status(const StatusSnapshot& s) {
   m.pose_age_s = s.pose_age_s;
   m.fix_type = static_cast<std::int8_t>(s.fix_type);
   m.h_acc_m = s.h_acc_m;
+  m.host_minus_gnss_utc_s = s.host_minus_gnss_utc_s;
+  m.lidar_pps_status = s.lidar_pps_status;
+  m.lidar_gprmc_valid = s.lidar_gprmc_valid;
   m.processing_ms_p50 = percentile(processing_window_ms_, 0.50);
   m.processing_ms_p99 = percentile(processing_window_ms_, 0.99);
   m.latency_ms_p50 = percentile(latency_window_ms_, 0.50);

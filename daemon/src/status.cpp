@@ -121,6 +121,12 @@ void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64
   s.fix_type = fix != nullptr ? fix->quality.fix_type : 0;
   s.h_acc_m = fix != nullptr ? fix->quality.h_acc_m : 0.0;
   s.trajectory_distance_m = p.trajectory_distance_m();
+  s.host_minus_gnss_utc_s = p.host_minus_gnss_utc_s();
+  const auto& position = p.lidar_position();
+  s.lidar_pps_status = position ? static_cast<std::int8_t>(position->pps) : std::int8_t{-1};
+  s.lidar_gprmc_valid = !position || position->nmea != vlp16::NmeaError::kNone ? std::int8_t{-1}
+                        : position->rmc.valid                                  ? std::int8_t{1}
+                                                                               : std::int8_t{0};
   const std::string& reason = p.lidar_model_reason();
   const std::size_t n = std::min(reason.size(), s.model_reason.size() - 1);
   std::copy_n(reason.begin(), n, s.model_reason.begin());

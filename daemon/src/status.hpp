@@ -94,6 +94,9 @@ struct StatusSnapshot {
   // For the fault lines (health.hpp): the robot's distance to the active trajectory at the
   // last sweep with a pose (NaN before), and the model check's last rejection ("" if none).
   double trajectory_distance_m = 0.0;
+  double host_minus_gnss_utc_s = 0.0;  // NaN: unknown
+  std::int8_t lidar_pps_status = -1;   // vlp16::PpsStatus of the newest position packet, -1: none
+  std::int8_t lidar_gprmc_valid = -1;  // its RMC: 1 valid, 0 not, -1 none
   std::array<char, 160> model_reason{};
   std::array<std::uint64_t, kCounterCount> counters{};
 

@@ -146,6 +146,12 @@ void SweepProcessor::lidar_datagram(LidarPort port, std::span<const std::uint8_t
   decoder_.on_data_packet(payload, receive_ns, adapter);
 }
 
+double SweepProcessor::host_minus_gnss_utc_s() const noexcept {
+  const auto& gnss = pose_input_.gnss_utc();
+  if (!gnss || !host_utc_offset_ns_) return std::numeric_limits<double>::quiet_NaN();
+  return static_cast<double>(gnss->host_ns + *host_utc_offset_ns_ - gnss->utc_ns) * 1e-9;
+}
+
 void SweepProcessor::pose_message(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) {
   (void)receive_ns;  // the message carries its own time
   trajroi::pose_input_t m;
@@ -208,6 +214,16 @@ void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
   s.centres.clear();
   s.truncated = 0;
   s.start_ns = frame.start_time_ns;
+  if (frame.start_utc_ns) {
+    s.start_utc_ns = *frame.start_utc_ns;
+    s.time_source = "vlp16_pps";
+  } else if (host_utc_offset_ns_) {
+    s.start_utc_ns = frame.start_time_ns + *host_utc_offset_ns_;
+    s.time_source = "host";
+  } else {
+    s.start_utc_ns = 0;
+    s.time_source = "none";
+  }
   s.pose_t_ns = frame.start_time_ns;
   s.trajectory_id = active_->id;
   s.shape = r.shape;

@@ -22,6 +22,7 @@ void input_loop(Pipeline& pipeline, InputLane& lane);
 struct ProcessingOptions {
   // Testing only (the watchdog test): after this many seconds the loop stops making progress.
   std::optional<double> stall_after_s;
+  bool live = true;  // the host clock's UTC offset is the inputs' (false in a replay)
 };
 void processing_loop(Pipeline& pipeline, SweepProcessor& processor, const ProcessingOptions& options);
 

@@ -109,6 +109,7 @@ int run_pipeline(Pipeline& pipeline, SweepProcessor& processor, Outlet& outlet, 
   Publisher publisher(pipeline, outlet, &reloader, options.replay.has_value());
   ProcessingOptions processing;
   processing.stall_after_s = options.stall_processing_after_s;
+  processing.live = !options.replay.has_value();
 
   // Said from this thread before any other starts (which also sets up the logger once).
   for (const auto& lane : pipeline.inputs)

@@ -50,6 +50,7 @@ Said run(const DaemonConfig& config, int seconds, Change change, bool live = tru
   HealthMonitor monitor(config, live, 0);
   StatusSnapshot s;
   s.trajectory_distance_m = std::numeric_limits<double>::quiet_NaN();
+  s.host_minus_gnss_utc_s = std::numeric_limits<double>::quiet_NaN();
   Said said;
   for (int t = 1; t <= seconds; ++t) {
     s.steady_ns = t * kSecond;
@@ -184,6 +185,15 @@ TEST(Health, ASensorClockJumpIsNamedAsSuchNotAsLoss) {
     if (t == 2) s[Counter::kLidarClockJumps] += 1;
   });
   EXPECT_EQ(said.first("lidar: the sensor's clock jumped forward 1 time(s) in the last second"), 2) << said.all();
+}
+
+TEST(Health, AHostClockFarFromGnssTimeIsWarnedWithTheOffset) {
+  const Said said = run(live_config(), 4, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s.host_minus_gnss_utc_s = t < 3 ? 0.02 : -2.5;
+  });
+  EXPECT_EQ(said.first("time: the host clock is 2.500 s behind GNSS UTC (more than time.max_gnss_offset_s 0.100 s)"), 3)
+      << said.all();
 }
 
 TEST(Health, TheStateSaysWhyThereIsNoPose) {

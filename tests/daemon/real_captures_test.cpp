@@ -194,6 +194,12 @@ TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKee
                                          : source == std::string("lcm")    ? "localization"
                                                                            : "fixed";
     EXPECT_EQ(m.pose.heading_source, expected_heading);
+    // UTC from the VLP-16's own PPS-locked clock: its position packets carry a valid GPRMC,
+    // 2016-01-21 08:18:02 UTC, with the PPS locked (../shared/data/README.md).
+    EXPECT_EQ(m.time_source, "vlp16_pps");
+    EXPECT_GE(m.sweep_start_utc_ns, 1'453'364'282'000'000'000) << "sweep " << frame.index;
+    EXPECT_LE(m.sweep_start_utc_ns, 1'453'364'284'000'000'000) << "sweep " << frame.index;
+    EXPECT_EQ(m.pose.utc_ns, m.sweep_start_utc_ns);
     const auto expected = filter_keeps(frame, m, listener.rois.at(m.sweep_index), rig.dir, rig.trajectory_xy);
     const auto got = daemon_keeps(frame, m);
     // Some of the sweep, not all and not nothing: the circles cut through it.
@@ -209,6 +215,14 @@ TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKee
   const trajroi::status_t& last = listener.statuses.back();
   EXPECT_EQ(last.lost_packets, 0) << rig.logs();
   EXPECT_EQ(last.decode_errors, 0) << rig.logs();
+  EXPECT_EQ(last.lidar_pps_status, 2);   // locked
+  EXPECT_EQ(last.lidar_gprmc_valid, 1);  // 'A'
+  if (source == std::string("gnss_imu") || source == std::string("gnss")) {
+    // The receiver's log is from 2021-06-10: the host clock is years ahead of its GNSS time,
+    // reported and warned.
+    EXPECT_GT(last.host_minus_gnss_utc_s, 1e8);
+    EXPECT_NE(slurp(rig.daemon_log).find("time: the host clock is"), std::string::npos) << rig.logs();
+  }
   if (source == std::string("gnss_imu")) {
     // Every frame of the IMU stream had an attitude and no sensor time: placed at receipt.
     EXPECT_GT(counter(last, "pose.attitudes"), 10);

@@ -124,6 +124,7 @@ void PoseInput::on_ubx(const ublox::Message& m, std::int64_t receive_ns) {
     if (hp) ++counters_.high_precision;
   }
   fix.t_ns = gnss_clock_.map(std::int64_t{pvt.itow_ms} * 1'000'000, receive_ns) - config_.gnss_delay_ns;
+  if (pvt.utc_valid()) gnss_utc_ = GnssUtc{pvt.utc_ns(), fix.t_ns};
   if (buffer_.add_fix(fix)) {
     ++counters_.fixes;
   } else {

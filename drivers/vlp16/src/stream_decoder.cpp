@@ -74,6 +74,7 @@ void StreamDecoder::on_position_packet(std::span<const std::uint8_t> payload) {
     return;
   }
   ++counters_.nmea[static_cast<std::size_t>(packet.nmea)];
+  last_position_ = packet;
   if (packet.nmea == NmeaError::kNone) {
     if (!first_rmc_) first_rmc_ = packet;
     last_rmc_ = packet;

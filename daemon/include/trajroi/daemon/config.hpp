@@ -126,6 +126,10 @@ struct DaemonConfig {
     std::size_t max_points_per_sweep = 131072;  // a 5 Hz dual-return sweep is ≈ 115 000
   } buffers;
 
+  struct Time {
+    double max_gnss_offset_s = 0.1;  // host UTC − GNSS UTC beyond this is warned (NTP/chrony off?)
+  } time;
+
   struct Logging {
     std::string level = "info";       // trace debug info warn error critical off
     double warning_interval_s = 5.0;  // per-packet warnings: at most one per interval and kind

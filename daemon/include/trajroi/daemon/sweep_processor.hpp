@@ -69,14 +69,19 @@ struct Sweep {
   pose::PoseStatus pose_status = pose::PoseStatus::kNoGnss;
   double pose_measured = 0.0, pose_limit = 0.0;  // the failing figure and its limit (PoseQuery)
   std::string_view heading_source = "none";      // where the attitude came from (static text)
-  std::int64_t pose_t_ns = 0;                    // sweep start
-  PublishedPose robot;                           // global_from_robot at the start
-  PublishedPose sensor;                          // global_from_lidar at the start (used for the whole
-                                                 // sweep in per-sweep mode)
-  double speed_mps = 0.0;                        // over the last 0.5 s (0.2 s, 0.1 s after a pose gap)
-  bool speed_known = false;                      // false: the pose valid for less than 0.1 s (speed_mps 0)
-  pose::FixQuality fix;                          // newest fix at the sweep's start
-  std::int64_t fix_t_ns = 0;                     // its time (0: none)
+  // The sweep's start in UTC (ns since 1970; 0: unknown) and where that came from: "vlp16_pps"
+  // (the sensor's PPS-locked clock, its position packets with a valid RMC), "host" (the host's
+  // CLOCK_REALTIME, live), "none" (a replay without a PPS-locked sensor).
+  std::int64_t start_utc_ns = 0;
+  std::string_view time_source = "none";
+  std::int64_t pose_t_ns = 0;  // sweep start
+  PublishedPose robot;         // global_from_robot at the start
+  PublishedPose sensor;        // global_from_lidar at the start (used for the whole
+                               // sweep in per-sweep mode)
+  double speed_mps = 0.0;      // over the last 0.5 s (0.2 s, 0.1 s after a pose gap)
+  bool speed_known = false;    // false: the pose valid for less than 0.1 s (speed_mps 0)
+  pose::FixQuality fix;        // newest fix at the sweep's start
+  std::int64_t fix_t_ns = 0;   // its time (0: none)
 
   // The ROI chain.
   std::int32_t trajectory_id = 0;
@@ -150,6 +155,11 @@ class SweepProcessor {
   // Steady-clock time the next datagram entered the daemon: a sweep keeps that of the last
   // datagram that gave it points (for the latency figures; no effect on the output).
   void set_input_arrival(std::int64_t steady_ns) noexcept { arrival_ns_ = steady_ns; }
+  // Live: the host's CLOCK_REALTIME − CLOCK_MONOTONIC now (refreshed each second), for the
+  // sweeps' UTC and the host clock's offset from GNSS time. Unset in a replay.
+  void set_host_utc_offset(std::optional<std::int64_t> offset_ns) noexcept { host_utc_offset_ns_ = offset_ns; }
+  // Host UTC − GNSS UTC at the newest GNSS epoch with a valid time, s (NaN: not both known).
+  [[nodiscard]] double host_minus_gnss_utc_s() const noexcept;
   // Ends the stream: the sweep in progress goes out (partial).
   void flush(SweepSink& sink);
   // Sweeps carry point_index from now on (the evaluations; the daemon does not need it).
@@ -164,6 +174,9 @@ class SweepProcessor {
 
   [[nodiscard]] const ProcessorCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const vlp16::StreamCounters& lidar_counters() const noexcept { return decoder_.counters(); }
+  [[nodiscard]] const std::optional<vlp16::PositionPacket>& lidar_position() const noexcept {
+    return decoder_.last_position();
+  }
   [[nodiscard]] const pose_input::PoseInput& pose_input() const noexcept { return pose_input_; }
   [[nodiscard]] const pose::PoseBuffer& poses() const noexcept { return poses_; }
   // The robot's distance to the active trajectory at the last sweep with a pose (NaN before).
@@ -193,6 +206,7 @@ class SweepProcessor {
   std::unique_ptr<ActiveTrajectory> retired_;
   double s_hint_m_ = 0.0;
   double trajectory_distance_m_ = std::numeric_limits<double>::quiet_NaN();
+  std::optional<std::int64_t> host_utc_offset_ns_;
   bool have_hint_ = false;
   std::optional<std::int64_t> valid_since_ns_;  // first sweep start of the current valid run
 

@@ -120,6 +120,13 @@ class PoseInput {
   [[nodiscard]] const ClockMap& gnss_clock() const noexcept { return gnss_clock_; }
   [[nodiscard]] const ClockMap& imu_clock() const noexcept { return imu_clock_; }
   [[nodiscard]] HeadingSource heading_source() const noexcept { return heading_source_; }
+  // The newest NAV-PVT with a valid, resolved UTC: that UTC (ns since 1970) and the epoch's
+  // host time (monotonic ns), for the host clock's offset from GNSS time.
+  struct GnssUtc {
+    std::int64_t utc_ns = 0;
+    std::int64_t host_ns = 0;
+  };
+  [[nodiscard]] const std::optional<GnssUtc>& gnss_utc() const noexcept { return gnss_utc_; }
 
  private:
   void gnss_heading(const ublox::NavPvt& pvt, std::int64_t t_ns);
@@ -139,6 +146,7 @@ class PoseInput {
   std::optional<ublox::NavRelposned> relpos_;
   std::optional<double> heading_yaw_rad_;  // the last GNSS (or configured) heading, global yaw
   HeadingSource heading_source_ = HeadingSource::kNone;
+  std::optional<GnssUtc> gnss_utc_;
   std::optional<pose::Geodetic> last_position_;
   std::optional<Eigen::Vector3d> last_global_;  // last_position_ in the global frame
   PoseInputCounters counters_;

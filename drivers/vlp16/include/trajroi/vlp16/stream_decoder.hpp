@@ -123,6 +123,8 @@ class StreamDecoder {
   [[nodiscard]] const ModelCheck& model_check() const noexcept { return model_; }
   [[nodiscard]] const std::optional<PositionPacket>& first_rmc() const noexcept { return first_rmc_; }
   [[nodiscard]] const std::optional<PositionPacket>& last_rmc() const noexcept { return last_rmc_; }
+  // The newest position packet parsed (its PPS status and RMC validity), whatever its NMEA.
+  [[nodiscard]] const std::optional<PositionPacket>& last_position() const noexcept { return last_position_; }
   [[nodiscard]] const TopOfHourClock& utc_clock() const noexcept { return utc_clock_; }
 
  private:
@@ -167,6 +169,7 @@ class StreamDecoder {
   std::optional<ReturnMode> return_mode_;
   std::optional<PositionPacket> first_rmc_;
   std::optional<PositionPacket> last_rmc_;
+  std::optional<PositionPacket> last_position_;
 };
 
 }  // namespace trajroi::vlp16
