@@ -4,11 +4,19 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
+#include <span>
+#include <string>
 #include <vector>
 
+#include "test_data.hpp"
+#include "trajroi/pose/attitude.hpp"
 #include "trajroi/ublox/config.hpp"
+#include "trajroi/vn100/decoder.hpp"
+#include "trajroi/vn100/framer.hpp"
 
 namespace trajroi::pose_input {
 namespace {
@@ -121,6 +129,130 @@ TEST_F(PoseInputTest, APositionOffTheEllipsoidIsCountedNotThrown) {
   const pose::GnssFix* newest = buffer_.newest_fix();
   ASSERT_NE(newest, nullptr);
   EXPECT_NEAR(newest->antenna_global_m.y(), 1.11, 0.01) << "0.00001° north of the origin";
+}
+
+// Yaw (rad, ENU) of the attitude the buffer holds at t.
+double yaw_at(const pose::PoseBuffer& buffer, std::int64_t t_ns) {
+  const pose::PoseQuery q = buffer.pose_at(t_ns);
+  EXPECT_TRUE(q.valid()) << pose::to_string(q.status);
+  return std::atan2(q.global_from_robot.linear()(1, 0), q.global_from_robot.linear()(0, 0));
+}
+
+// The VN-100 outputs people configure: YawPitchRoll, Quaternion or DCM alone, no time field
+// (the data set's real logger). Each gives the same attitude, placed at its receive time minus
+// the configured delay.
+TEST(PoseInputImu, AnyAttitudeOutputWithoutATimeFieldGivesTheAttitude) {
+  const pose::Geodetic origin{36.0, 127.0, 50.0};
+  const Eigen::Quaterniond ned_from_frd = pose::ned_from_frd_ypr(30.0, 5.0, -3.0);
+  const auto attitude = [&](vn100::Field field) {
+    PoseInputConfig config;
+    config.imu_delay_ns = 4'000'000;
+    pose::PoseBuffer buffer(pose::PoseGate{}, Eigen::Vector3d::Zero(), 64);
+    PoseInput input(pose::GlobalFrame::local_cartesian(origin), config, buffer);
+    ublox::NavPvt m;
+    m.fix_type_raw = 3;
+    m.gnss_fix_ok = true;
+    m.lat_e7 = 360'000'000;
+    m.lon_e7 = 1'270'000'000;
+    m.h_acc_mm = 100;
+    for (int k = 0; k < 3; ++k) {
+      m.itow_ms = static_cast<std::uint32_t>(1000 + 100 * k);
+      input.gnss_bytes(ublox::encode_nav_pvt(m), 1'000'000'000 + k * 100'000'000);
+    }
+    vn100::Sample s;
+    s.set(field);
+    s.ypr_deg = {30.0f, 5.0f, -3.0f};
+    const Eigen::Quaterniond q = ned_from_frd;
+    s.quaternion_xyzw = {static_cast<float>(q.x()), static_cast<float>(q.y()), static_cast<float>(q.z()),
+                         static_cast<float>(q.w())};
+    const Eigen::Matrix3d r = q.toRotationMatrix();
+    for (int i = 0; i < 9; ++i)
+      s.dcm[static_cast<std::size_t>(i)] = static_cast<float>(r(i / 3, i % 3));
+    std::array<std::uint16_t, 8> groups{};
+    groups[4] = field == vn100::Field::kYawPitchRoll ? 0x0002 : field == vn100::Field::kQuaternion ? 0x0004 : 0x0008;
+    for (int k = 0; k < 3; ++k)
+      input.imu_bytes(vn100::encode(s, groups), 1'004'000'000 + k * 100'000'000);
+    EXPECT_EQ(input.counters().attitudes, 3u);
+    EXPECT_EQ(input.counters().imu_receive_stamped, 3u);
+    EXPECT_EQ(input.counters().imu_without_attitude, 0u);
+    EXPECT_EQ(input.heading_source(), HeadingSource::kImu);
+    const pose::PoseQuery at = buffer.pose_at(1'100'000'000);  // receive 1.104 s − 4 ms
+    EXPECT_TRUE(at.valid()) << pose::to_string(at.status);
+    return Eigen::Quaterniond(at.global_from_robot.linear());
+  };
+  const Eigen::Quaterniond from_ypr = attitude(vn100::Field::kYawPitchRoll);
+  EXPECT_LT(from_ypr.angularDistance(attitude(vn100::Field::kQuaternion)), 1e-6);
+  EXPECT_LT(from_ypr.angularDistance(attitude(vn100::Field::kDcm)), 1e-6);
+}
+
+// pose.source gnss: the course over ground above the speed, else the last heading held; before
+// any, the configured initial heading.
+TEST(PoseInputGnss, HeadingFromTheCourseOverGroundHeldWhenSlow) {
+  const pose::Geodetic origin{36.0, 127.0, 50.0};
+  PoseInputConfig config;
+  config.attitude = AttitudeFrom::kGnss;
+  config.heading.min_speed_mps = 1.0;
+  config.heading.max_heading_acc_deg = 5.0;
+  config.initial_heading_deg = 180.0;  // facing south
+  pose::PoseBuffer buffer(pose::PoseGate{}, Eigen::Vector3d::Zero(), 64);
+  PoseInput input(pose::GlobalFrame::local_cartesian(origin), config, buffer);
+  ublox::NavPvt m;
+  m.fix_type_raw = 3;
+  m.gnss_fix_ok = true;
+  m.lat_e7 = 360'000'000;
+  m.lon_e7 = 1'270'000'000;
+  m.h_acc_mm = 100;
+  const auto epoch = [&](int k, double speed_mps, double course_deg, double acc_deg) {
+    m.itow_ms = static_cast<std::uint32_t>(1000 + 100 * k);
+    m.ground_speed_mmps = static_cast<std::int32_t>(speed_mps * 1000.0);
+    m.head_mot_e5deg = static_cast<std::int32_t>(course_deg * 1e5);
+    m.head_acc_e5deg = static_cast<std::uint32_t>(acc_deg * 1e5);
+    input.gnss_bytes(ublox::encode_nav_pvt(m), 1'000'000'000 + k * 100'000'000);
+  };
+  epoch(0, 0.1, 0.0, 90.0);  // parked: the configured heading
+  epoch(1, 0.1, 0.0, 90.0);
+  EXPECT_EQ(input.heading_source(), HeadingSource::kConfigured);
+  EXPECT_NEAR(yaw_at(buffer, 1'050'000'000), -std::numbers::pi / 2, 1e-6);  // south
+  epoch(2, 2.0, 90.0, 1.0);                                                 // driving east
+  epoch(3, 2.0, 90.0, 1.0);
+  EXPECT_EQ(input.heading_source(), HeadingSource::kCourse);
+  EXPECT_NEAR(yaw_at(buffer, 1'250'000'000), 0.0, 1e-6);
+  epoch(4, 0.2, 300.0, 60.0);  // stopped: the course is noise, the last heading is held
+  EXPECT_EQ(input.heading_source(), HeadingSource::kHeld);
+  EXPECT_NEAR(yaw_at(buffer, 1'350'000'000), 0.0, 1e-6);
+  epoch(5, 2.0, 20.0, 10.0);  // fast but the course too uncertain: held
+  EXPECT_EQ(input.heading_source(), HeadingSource::kHeld);
+  EXPECT_EQ(input.counters().gnss_headings, 6u);
+}
+
+// The real VN-100 log (LoggerWavesInIce F00379, YawPitchRoll and DCM in every frame): the DCM
+// as the frame carries it (row-major) is the rotation the yaw/pitch/roll give, Rz Ry Rx — the
+// convention enu_from_vn_rotation() takes it in — to float rounding, in every one of the 8,895
+// frames.
+TEST(PoseInputImu, TheRealLogsDcmIsTheRotationOfItsYawPitchRoll) {
+  TRAJROI_REQUIRE_DATA(raw, "vectornav/LoggerWavesInIce_F00379.raw");
+  const std::string bytes = ::trajroi::test::read_file(raw);
+  vn100::Framer framer;
+  std::size_t frames = 0;
+  double worst_rad = 0.0;
+  framer.feed(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()),
+              [&](std::span<const std::uint8_t> frame) {
+                vn100::Sample s;
+                ASSERT_TRUE(vn100::decode(frame, s));
+                ASSERT_TRUE(s.has(vn100::Field::kYawPitchRoll) && s.has(vn100::Field::kDcm));
+                Eigen::Matrix3d dcm;
+                for (int i = 0; i < 9; ++i)
+                  dcm(i / 3, i % 3) = static_cast<double>(s.dcm[static_cast<std::size_t>(i)]);
+                const Eigen::Matrix3d ypr =
+                    pose::ned_from_frd_ypr(static_cast<double>(s.ypr_deg[0]), static_cast<double>(s.ypr_deg[1]),
+                                           static_cast<double>(s.ypr_deg[2]))
+                        .toRotationMatrix();
+                worst_rad = std::max(worst_rad, (dcm - ypr).cwiseAbs().maxCoeff());
+                ++frames;
+              });
+  EXPECT_EQ(frames, 8895u);
+  EXPECT_LT(worst_rad, 1e-4);
+  std::printf("[ vn100 ] %zu real frames: DCM − Rz·Ry·Rx(YPR) at most %.2e\n", frames, worst_rad);
 }
 
 }  // namespace

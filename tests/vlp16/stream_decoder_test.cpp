@@ -316,3 +316,58 @@ TEST(Vlp16Stream, LockedPositionPacketsGiveFramesTheirUtcStart) {
 
 }  // namespace
 }  // namespace trajroi::vlp16
+
+namespace trajroi::vlp16 {
+namespace {
+
+// The firmware writes 36000 for a block fired exactly at the wrap (before writing 0): that is
+// 0°, the packet is kept whole and nothing is lost (ros-drivers/velodyne, VeloView: modulo).
+TEST(Vlp16Stream, ABlockAzimuthOf36000IsZeroNotALostPacket) {
+  const Outcome clean = run(Sensor{}, 3 * kPacketsPerTurn);
+  const Outcome r = run(Sensor{}, 3 * kPacketsPerTurn, {}, [](std::size_t i, std::vector<std::uint8_t>& p) {
+    if (i == kPacketsPerTurn) {  // block 0 of this packet fires at 0°
+      EXPECT_EQ(p[2] | (p[3] << 8), 0);
+      p[2] = 0xA0;  // 36000 = 0x8CA0
+      p[3] = 0x8C;
+    }
+    return true;
+  });
+  EXPECT_EQ(r.counters.rejected[static_cast<std::size_t>(PacketError::kAzimuthOutOfRange)], 0u);
+  EXPECT_EQ(r.counters.lost_packets, 0u);
+  EXPECT_EQ(r.counters.decoded_packets, clean.counters.decoded_packets);
+  ASSERT_EQ(r.sink.frames.size(), clean.sink.frames.size());
+  for (std::size_t f = 0; f < r.sink.frames.size(); ++f)
+    EXPECT_EQ(r.sink.frames[f].points.size(), clean.sink.frames[f].points.size()) << f;
+  // Above 36000 stays out of range.
+  auto p = make_packet(0, 40, ReturnMode::kStrongest);
+  p[2] = 0xA1;
+  p[3] = 0x8C;
+  EXPECT_EQ(validate_data_packet(p), PacketError::kAzimuthOutOfRange);
+  p[2] = 0xA0;
+  EXPECT_EQ(validate_data_packet(p), PacketError::kNone);
+  EXPECT_EQ(block_azimuth(p, 0), 0);
+}
+
+// The sensor's clock jumping forward 10 s between two packets 1.3 ms apart on the host is no
+// loss of 7 500 packets: it is counted as a clock jump, and nothing as lost.
+TEST(Vlp16Stream, ASensorClockJumpIsCountedAsSuchNotAsLostPackets) {
+  const Outcome r = run(Sensor{}, 3 * kPacketsPerTurn, {}, [](std::size_t i, std::vector<std::uint8_t>& p) {
+    if (i >= 100) {
+      std::uint32_t toh = static_cast<std::uint32_t>(p[1200]) | (static_cast<std::uint32_t>(p[1201]) << 8) |
+                          (static_cast<std::uint32_t>(p[1202]) << 16) | (static_cast<std::uint32_t>(p[1203]) << 24);
+      toh += 10'000'000;
+      for (std::size_t k = 0; k < 4; ++k)
+        p[1200 + k] = static_cast<std::uint8_t>(toh >> (8 * k));
+    }
+    return true;
+  });
+  EXPECT_EQ(r.counters.clock_jumps, 1u);
+  EXPECT_EQ(r.counters.lost_packets, 0u);
+  // A real gap (packets missing, the host's time passing with them) is still loss.
+  const Outcome lost = run(Sensor{}, 3 * kPacketsPerTurn, {}, [](std::size_t i, auto&) { return i < 100 || i > 102; });
+  EXPECT_EQ(lost.counters.clock_jumps, 0u);
+  EXPECT_EQ(lost.counters.lost_packets, 3u);
+}
+
+}  // namespace
+}  // namespace trajroi::vlp16
