@@ -79,6 +79,9 @@ void read_serial(MapReader& m, DaemonConfig::Serial& s) {
   m.require(serial::is_supported_baud(s.baud), "baud", "must be one of " + serial::supported_bauds_text());
   s.delay_s = m.number("delay_s", 0.0);
   m.require(s.delay_s >= 0.0 && s.delay_s < 1.0, "delay_s", "must be in [0, 1) s");
+  s.configure = m.boolean("configure", false);
+  s.rate_hz = m.positive("rate_hz", s.rate_hz);
+  m.require(s.rate_hz <= 800.0, "rate_hz", "must be at most 800 Hz");
 }
 
 ThreadConfig read_thread(MapReader& parent, std::string_view key) {
@@ -416,6 +419,8 @@ std::string describe(const DaemonConfig& c) {
     line(std::string(name) + ".device", s.device);
     num(std::string(name) + ".baud", s.baud);
     num(std::string(name) + ".delay_s", s.delay_s);
+    flag(std::string(name) + ".configure", s.configure);
+    num(std::string(name) + ".rate_hz", s.rate_hz);
   };
   serial("gnss", c.gnss);
   line("gnss.antenna", format_vector(c.gnss_antenna_m));

@@ -18,12 +18,37 @@
 #include "realtime.hpp"
 #include "reload.hpp"
 #include "threads.hpp"
+#include "trajroi/configure/receiver_config.hpp"
 #include "trajroi/inputs/live_input.hpp"
 #include "trajroi/inputs/recorded_input.hpp"
 
 namespace trajroi::daemon {
 
 namespace {
+
+// gnss.configure / imu.configure: the receiver's output set each time its device opens; the
+// outcome (and each refused step) is said with the open.
+inputs::SerialInput::OnOpen receiver_configuration(const DaemonConfig& config, inputs::Stream stream) {
+  return [&config, stream](serial::SerialPortSource& port) {
+    configure::Result r;
+    if (stream == inputs::Stream::kGnss) {
+      configure::UbloxSettings s;
+      s.rate_hz = config.gnss.rate_hz;
+      s.port = configure::guess_ublox_port(config.gnss.device);
+      s.relposned = config.pose_source == PoseSource::kGnss;
+      r = configure::configure_ublox(port, s);
+    } else {
+      configure::Vn100Settings s;
+      s.rate_hz = config.imu.rate_hz;
+      r = configure::configure_vn100(port, s);
+    }
+    std::string text = r.summary;
+    for (const configure::Step& step : r.steps) {
+      if (!step.ok) text += "; " + step.what + ": " + step.answer;
+    }
+    return inputs::Notice{r.ok ? inputs::Notice::Level::kInfo : inputs::Notice::Level::kWarning, text};
+  };
+}
 
 // The live sensors, or the recorded run: the only difference between live and replay.
 void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions& options) {
@@ -55,8 +80,9 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
     o.baud = s.baud;
     // A receiver that comes back (cable, USB re-enumeration) is read again within 0.5 s.
     o.max_backoff = std::chrono::milliseconds(500);
-    pipeline.add_input(std::make_unique<inputs::SerialInput>(name, stream, o), config.buffers.serial_chunks,
-                       std::string("trajroid-") + name, thread);
+    auto input = std::make_unique<inputs::SerialInput>(name, stream, o);
+    if (s.configure) input->on_open(receiver_configuration(config, stream));
+    pipeline.add_input(std::move(input), config.buffers.serial_chunks, std::string("trajroid-") + name, thread);
   };
   // What the pose source reads (a device configured for an unused stream is left closed).
   if (config.pose_source == PoseSource::kGnssImu || config.pose_source == PoseSource::kGnss) {

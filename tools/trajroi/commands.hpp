@@ -11,8 +11,9 @@ void add_lidar_dump_command(CLI::App& app);
 void add_serial_dump_commands(CLI::App& app);  // gnss-dump, imu-dump
 void add_sim_command(CLI::App& app);
 void add_render_command(CLI::App& app);
-void add_watch_command(CLI::App& app);  // listens to trajroid over LCM
-void add_feed_command(CLI::App& app);   // plays a run folder into a live trajroid
+void add_watch_command(CLI::App& app);      // listens to trajroid over LCM
+void add_configure_command(CLI::App& app);  // trajroi configure gnss|imu
+void add_feed_command(CLI::App& app);       // plays a run folder into a live trajroid
 // keyframes, sequential, accumulated under `eval`.
 void add_scenario_eval_commands(CLI::App& eval_cmd);
 

@@ -91,6 +91,12 @@ SerialInput::Next SerialInput::next(InputItem& item, std::chrono::milliseconds t
                      (port_->backend() == serial::SerialPortSource::Backend::kTermios ? "termios" : "libserialport") +
                      " backend)"};
       have_pending_ = status == serial::ReadStatus::kData;
+      if (on_open_) {
+        have_pending_ = false;
+        const Notice configured = on_open_(*port_);
+        notice_.text += "; " + configured.text;
+        notice_.level = configured.level;
+      }
       return Next::kNotice;
     }
   }

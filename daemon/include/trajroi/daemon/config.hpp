@@ -68,10 +68,20 @@ struct DaemonConfig {
     std::string device;  // empty: this stream is not used live
     int baud = 115200;
     double delay_s = 0.0;
+    bool configure = false;  // set the receiver's output each time the device opens
+    double rate_hz = 0.0;    // … at this rate (gnss default 5 Hz, imu 40 Hz)
   };
-  Serial gnss;
+  Serial gnss = [] {
+    Serial s;
+    s.rate_hz = 5.0;
+    return s;
+  }();
   Eigen::Vector3d gnss_antenna_m = Eigen::Vector3d::Zero();  // in the robot frame
-  Serial imu;
+  Serial imu = [] {
+    Serial s;
+    s.rate_hz = 40.0;
+    return s;
+  }();
   double magnetic_declination_deg = 0.0;
   Eigen::Quaterniond robot_from_imu = Eigen::Quaterniond::Identity();
 

@@ -3,6 +3,7 @@
 // The live inputs: the VLP-16's UDP sockets and the serial ports of the GNSS receiver and the
 // IMU. Each converts its receive stamps to CLOCK_MONOTONIC here, at the edge (the kernel
 // stamps datagrams with CLOCK_REALTIME; serial reads are stamped monotonic already).
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -38,6 +39,10 @@ class SerialInput final : public InputSource {
   // `name` is "gnss" or "imu" (for notices); `stream` what its bytes are. Throws
   // std::invalid_argument for options the port layer refuses (serial::SerialPortSource).
   SerialInput(std::string name, Stream stream, serial::SerialPortOptions options);
+  // Run each time the device opens (receiver configuration): its notice is said with the
+  // open's. The bytes read with the opening are dropped (the hook reads the port).
+  using OnOpen = std::function<Notice(serial::SerialPortSource&)>;
+  void on_open(OnOpen hook) { on_open_ = std::move(hook); }
   ~SerialInput() override;
 
   Next next(InputItem& item, std::chrono::milliseconds timeout) override;
@@ -55,6 +60,7 @@ class SerialInput final : public InputSource {
   serial::Chunk pending_;       // the last read; its bytes live in the port until the next read
   bool have_pending_ = false;   // read with the port's opening, handed out after the notice
   Notice notice_;
+  OnOpen on_open_;
 };
 
 }  // namespace trajroi::inputs
