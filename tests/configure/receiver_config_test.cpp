@@ -52,7 +52,8 @@ class ScriptedDevice {
       if (poll(&p, 1, 20) <= 0 || (p.revents & POLLIN) == 0) continue;
       const ssize_t n = read(master_, buffer, sizeof buffer);
       if (n <= 0) continue;
-      const std::vector<std::uint8_t> reply = answer_(std::span<const std::uint8_t>(buffer, static_cast<std::size_t>(n)));
+      const std::vector<std::uint8_t> reply =
+          answer_(std::span<const std::uint8_t>(buffer, static_cast<std::size_t>(n)));
       if (!reply.empty()) (void)!write(master_, reply.data(), reply.size());
     }
   }
@@ -64,7 +65,8 @@ class ScriptedDevice {
 };
 
 // A u-blox: each UBX message in gets `verdict(class, id, payload)`: 1 ACK-ACK, 0 ACK-NAK, -1 silence.
-ScriptedDevice::Answer ublox_device(std::function<int(std::uint8_t, std::uint8_t, std::span<const std::uint8_t>)> verdict) {
+ScriptedDevice::Answer ublox_device(
+    std::function<int(std::uint8_t, std::uint8_t, std::span<const std::uint8_t>)> verdict) {
   auto framer = std::make_shared<ublox::Framer>();
   return [framer, verdict](std::span<const std::uint8_t> in) {
     std::vector<std::uint8_t> out;
@@ -205,14 +207,13 @@ TEST(ReceiverConfig, AVn100RegisterIsWrittenAndReadBack) {
 TEST(ReceiverConfig, TheConfigureCommandReportsAndExitsByTheOutcome) {
   ScriptedDevice f9(ublox_device([](auto, auto, auto) { return 1; }));
   const std::string out = ::testing::TempDir() + "configure_cli.txt";
-  int status = std::system((std::string(TRAJROI_CLI) + " configure gnss --device " + f9.path() + " --rate 10 > " +
-                            out + " 2>&1")
-                               .c_str());
+  int status = std::system(
+      (std::string(TRAJROI_CLI) + " configure gnss --device " + f9.path() + " --rate 10 > " + out + " 2>&1").c_str());
   EXPECT_EQ(WEXITSTATUS(status), 0);
   ScriptedDevice silent(ublox_device([](auto, auto, auto) { return -1; }));
-  status = std::system((std::string(TRAJROI_CLI) + " configure gnss --device " + silent.path() +
-                        " --timeout-ms 200 >> " + out + " 2>&1")
-                           .c_str());
+  status = std::system(
+      (std::string(TRAJROI_CLI) + " configure gnss --device " + silent.path() + " --timeout-ms 200 >> " + out + " 2>&1")
+          .c_str());
   EXPECT_EQ(WEXITSTATUS(status), 1);
   std::FILE* f = std::fopen(out.c_str(), "r");
   ASSERT_NE(f, nullptr);

@@ -215,6 +215,8 @@ TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKee
   const trajroi::status_t& last = listener.statuses.back();
   EXPECT_EQ(last.lost_packets, 0) << rig.logs();
   EXPECT_EQ(last.decode_errors, 0) << rig.logs();
+  for (const trajroi::status_t& s : listener.statuses)
+    EXPECT_TRUE(s.pose_age_s >= 0.0 || s.pose_age_s == -1.0) << "pose age " << s.pose_age_s;  // never negative
   EXPECT_EQ(last.lidar_pps_status, 2);   // locked
   EXPECT_EQ(last.lidar_gprmc_valid, 1);  // 'A'
   if (source == std::string("gnss_imu") || source == std::string("gnss")) {

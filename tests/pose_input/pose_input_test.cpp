@@ -187,6 +187,43 @@ TEST(PoseInputImu, AnyAttitudeOutputWithoutATimeFieldGivesTheAttitude) {
 
 // pose.source gnss: the course over ground above the speed, else the last heading held; before
 // any, the configured initial heading.
+// A moving base: NAV-RELPOSNED's relPosHeading (valid, accurate) of the same epoch is the
+// heading, even parked; the baseline's direction in the robot frame is taken off.
+TEST(PoseInputGnss, AMovingBaseBaselineGivesTheHeadingStandingStill) {
+  const pose::Geodetic origin{36.0, 127.0, 50.0};
+  PoseInputConfig config;
+  config.attitude = AttitudeFrom::kGnss;
+  config.heading.baseline_yaw_in_robot_rad = std::numbers::pi / 2;  // antennas mounted right → left
+  pose::PoseBuffer buffer(pose::PoseGate{}, Eigen::Vector3d::Zero(), 64);
+  PoseInput input(pose::GlobalFrame::local_cartesian(origin), config, buffer);
+  for (int k = 0; k < 2; ++k) {
+    // UBX-NAV-RELPOSNED version 1 (64 bytes), laid out by the F9 interface description:
+    // iTOW at 4, relPosHeading (1e-5°) at 24, accHeading at 52, flags at 60 (gnssFixOK bit 0,
+    // relPosValid bit 2, relPosHeadingValid bit 8). The baseline points north (heading 0).
+    const auto itow = static_cast<std::uint32_t>(1000 + 100 * k);
+    std::vector<std::uint8_t> payload(64, 0);
+    payload[0] = 1;
+    for (int b = 0; b < 4; ++b) {
+      payload[static_cast<std::size_t>(4 + b)] = static_cast<std::uint8_t>(itow >> (8 * b));
+      payload[static_cast<std::size_t>(52 + b)] = static_cast<std::uint8_t>(50'000U >> (8 * b));  // 0.5°
+    }
+    payload[60] = 0x05;
+    payload[61] = 0x01;
+    input.gnss_bytes(ublox::encode_frame(0x01, 0x3C, payload), 1'000'000'000 + k * 100'000'000);
+    ublox::NavPvt m;
+    m.itow_ms = itow;
+    m.fix_type_raw = 3;
+    m.gnss_fix_ok = true;
+    m.lat_e7 = 360'000'000;
+    m.lon_e7 = 1'270'000'000;
+    m.h_acc_mm = 100;
+    input.gnss_bytes(ublox::encode_nav_pvt(m), 1'000'000'000 + k * 100'000'000);
+  }
+  EXPECT_EQ(input.heading_source(), HeadingSource::kBaseline);
+  // Baseline north (ENU yaw 90°) is the robot's left: the robot faces east (yaw 0).
+  EXPECT_NEAR(yaw_at(buffer, 1'050'000'000), 0.0, 1e-6);
+}
+
 TEST(PoseInputGnss, HeadingFromTheCourseOverGroundHeldWhenSlow) {
   const pose::Geodetic origin{36.0, 127.0, 50.0};
   PoseInputConfig config;

@@ -141,5 +141,29 @@ TEST(Vlp16Udp, BadAddressAndTakenPortAreClearErrors) {
   ::close(holder);
 }
 
+// The sensor's port is exclusive: a second source on it fails naming the port; with
+// share_ports (multicast set-ups) both bind and both receive.
+TEST(Vlp16Udp, ThePortIsExclusiveUnlessSharingIsAskedFor) {
+  UdpSource first(loopback());
+  UdpOptions same = loopback();
+  same.data_port = first.data_port();
+  same.open_position_socket = false;
+  try {
+    UdpSource second(same);
+    FAIL() << "a second source bound the same port";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("127.0.0.1:" + std::to_string(same.data_port) +
+                                         ": bind: Address already in use (another process receives on this port"),
+              std::string::npos)
+        << e.what();
+  }
+  UdpOptions shared = loopback();
+  shared.share_ports = true;
+  UdpSource a(shared);
+  shared.data_port = a.data_port();
+  shared.open_position_socket = false;
+  EXPECT_NO_THROW(UdpSource b(shared));
+}
+
 }  // namespace
 }  // namespace trajroi::vlp16

@@ -240,9 +240,9 @@ Result configure_vn100(serial::SerialPortSource& port, const Vn100Settings& s) {
   (void)port.write(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(read.data()), read.size()),
                    s.timeout);
   const std::string back = vn_answer(port, "VNRRG,75", s.timeout, ok);
-  const bool same = ok && register_fields(back.substr(1, back.find('*') == std::string::npos
-                                                                ? std::string::npos
-                                                                : back.find('*') - 1)) == register_fields(body);
+  const bool same = ok && register_fields(back.substr(
+                              1, back.find('*') == std::string::npos ? std::string::npos : back.find('*') - 1)) ==
+                              register_fields(body);
   r.steps.push_back({"read back register 75", same, ok && !same ? back + " differs from " + body : back});
   r.summary = same ? device + ": VN-100 configured: " + what
                    : device + ": VN-100 register 75 read back " + back + ", not what was written (" + body + ")";

@@ -21,7 +21,7 @@
 namespace trajroi::configure {
 
 struct Step {
-  std::string what;    // "CFG-VALSET (F9): NAV-PVT, NAV-HPPOSLLH at 5 Hz on USB"
+  std::string what;  // "CFG-VALSET (F9): NAV-PVT, NAV-HPPOSLLH at 5 Hz on USB"
   bool ok = false;
   std::string answer;  // "ACK-ACK", "ACK-NAK", "no answer within 1000 ms", "$VNERR,03 (invalid parameter)"
 };
