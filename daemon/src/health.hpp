@@ -31,7 +31,7 @@ class HealthMonitor {
   [[nodiscard]] const std::string& state() const noexcept { return state_; }
 
   // A fault is judged over at least this much history (the lines come within 5 s).
-  static constexpr std::int64_t kWindow_ns = 4'000'000'000;
+  static constexpr std::int64_t kWindow_ns = 3'000'000'000;
 
  private:
   enum Fault : std::uint8_t {

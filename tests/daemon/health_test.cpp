@@ -91,7 +91,7 @@ TEST(Health, NoLidarDatagramsAreNamedWithThePortWithinFiveSecondsAndTheirReturnT
     healthy(s, t);
     if (t <= 8) s.lidar_packets -= 754, s.position_packets -= 1;  // nothing until 8 s
   });
-  const int at = said.first("lidar: no datagrams for 4 s on UDP 0.0.0.0:2368 (data) / 8308 (position)");
+  const int at = said.first("lidar: no datagrams for 3 s on UDP 0.0.0.0:2368 (data) / 8308 (position)");
   EXPECT_GE(at, 1) << said.all();
   EXPECT_LE(at, 5);
   EXPECT_EQ(said.first("lidar: datagrams arriving on UDP port 2368"), 9) << said.all();
@@ -129,7 +129,7 @@ TEST(Health, BytesButNoFramesSayWrongBaudRateWithTheFigures) {
     s[Counter::kGnssFrames] -= 10;
     s[Counter::kPoseFixes] -= 10;
   });
-  const int at = said.first("gnss: 4000 bytes in 4 s from /dev/gnss at 115200 baud but no UBX frame: wrong baud rate?");
+  const int at = said.first("gnss: 3000 bytes in 3 s from /dev/gnss at 115200 baud but no UBX frame: wrong baud rate?");
   EXPECT_GE(at, 1) << said.all();
   EXPECT_LE(at, 5);
 }
@@ -144,11 +144,11 @@ TEST(Health, FramesOfTheOtherSensorSaySwappedDevices) {
     s[Counter::kPoseAttitudes] -= 40;
     s[Counter::kImuForeignFrames] += 10;
   });
-  EXPECT_LE(said.first("gnss: 160 VN-100 frames (and no UBX frame) in 4 s from /dev/gnss: gnss.device and "
+  EXPECT_LE(said.first("gnss: 120 VN-100 frames (and no UBX frame) in 3 s from /dev/gnss: gnss.device and "
                        "imu.device swapped?"),
             5)
       << said.all();
-  EXPECT_GE(said.first("imu: 40 UBX frames (and no VN-100 frame)"), 1) << said.all();
+  EXPECT_GE(said.first("imu: 30 UBX frames (and no VN-100 frame)"), 1) << said.all();
 }
 
 TEST(Health, ASilentReceiverAndMissingOutputsAreNamed) {
@@ -158,15 +158,15 @@ TEST(Health, ASilentReceiverAndMissingOutputsAreNamed) {
     s[Counter::kGnssFrames] -= 10;
     s[Counter::kPoseFixes] -= 10;
   });
-  EXPECT_GE(said.first("gnss: no bytes for 4 s from /dev/gnss"), 1) << said.all();
+  EXPECT_GE(said.first("gnss: no bytes for 3 s from /dev/gnss"), 1) << said.all();
   said = run(live_config(), 6, [](StatusSnapshot& s, int t) {
     healthy(s, t);
     s[Counter::kPoseFixes] -= 10;  // frames, but none a NAV-PVT
     s[Counter::kPoseAttitudes] -= 40;
     s[Counter::kPoseImuWithoutAttitude] += 40;
   });
-  EXPECT_GE(said.first("gnss: 40 UBX frames in 4 s but no NAV-PVT"), 1) << said.all();
-  EXPECT_GE(said.first("imu: 160 VN-100 frames in 4 s carry no YawPitchRoll, Quaternion or DCM"), 1) << said.all();
+  EXPECT_GE(said.first("gnss: 30 UBX frames in 3 s but no NAV-PVT"), 1) << said.all();
+  EXPECT_GE(said.first("imu: 120 VN-100 frames in 3 s carry no YawPitchRoll, Quaternion or DCM"), 1) << said.all();
 }
 
 TEST(Health, ATrajectoryFarFromTheRobotIsNamedWithTheDistance) {

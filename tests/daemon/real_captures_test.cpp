@@ -217,8 +217,8 @@ TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKee
   EXPECT_EQ(last.decode_errors, 0) << rig.logs();
   for (const trajroi::status_t& s : listener.statuses)
     EXPECT_TRUE(s.pose_age_s >= 0.0 || s.pose_age_s == -1.0) << "pose age " << s.pose_age_s;  // never negative
-  EXPECT_EQ(last.lidar_pps_status, 2);   // locked
-  EXPECT_EQ(last.lidar_gprmc_valid, 1);  // 'A'
+  EXPECT_EQ(last.lidar_pps_status, 2);                                                        // locked
+  EXPECT_EQ(last.lidar_gprmc_valid, 1);                                                       // 'A'
   if (source == std::string("gnss_imu") || source == std::string("gnss")) {
     // The receiver's log is from 2021-06-10: the host clock is years ahead of its GNSS time,
     // reported and warned.
@@ -268,7 +268,7 @@ TEST(LiveFaults, AMissingSerialDeviceAndASilentLidarPortAreNamedWithin5s) {
                           start);
   EXPECT_LOGGED_WITHIN_5S(rig, "imu: cannot open " + rig.imu_link.string() + ": No such file or directory (errno 2)",
                           start);
-  EXPECT_LOGGED_WITHIN_5S(rig, "lidar: no datagrams for 4 s on UDP 0.0.0.0:" + std::to_string(rig.data_port), start);
+  EXPECT_LOGGED_WITHIN_5S(rig, "lidar: no datagrams for 3 s on UDP 0.0.0.0:" + std::to_string(rig.data_port), start);
   daemon.signal(SIGTERM);
   EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
 }
@@ -285,8 +285,8 @@ TEST(LiveFaults, SwappedSerialDevicesAreNamed) {
                 "--imu-link", rig.gnss_link.string(), "--until", "8"},
                rig.feed_log);
   EXPECT_LOGGED_WITHIN_5S(
-      rig, "(and no UBX frame) in 4 s from " + rig.gnss_link.string() + ": gnss.device and imu.device swapped?", start);
-  EXPECT_LOGGED_WITHIN_5S(rig, "UBX frames (and no VN-100 frame) in 4 s from " + rig.imu_link.string(), start);
+      rig, "(and no UBX frame) in 3 s from " + rig.gnss_link.string() + ": gnss.device and imu.device swapped?", start);
+  EXPECT_LOGGED_WITHIN_5S(rig, "UBX frames (and no VN-100 frame) in 3 s from " + rig.imu_link.string(), start);
   daemon.signal(SIGTERM);
   EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
 }
