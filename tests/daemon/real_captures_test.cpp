@@ -358,6 +358,37 @@ TEST(LiveFaults, ATrajectoryFarFromTheRobotIsNamedWithItsDistance) {
   EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
 }
 
+// A rejected trajectory message is said even while withheld sweeps are being warned about:
+// each has its own rate limit (it was swallowed by the sweeps' before).
+TEST(LiveFaults, ARejectedTrajectoryMessageIsSaidAmidWithheldSweepWarnings) {
+  TRAJROI_REQUIRE_DATA(pcap, kPcap);
+  const Rig rig("rejected", "gnss_imu", 11);  // no GNSS, no IMU fed: every sweep is withheld
+  Listener listener(rig.prefix);
+  ASSERT_TRUE(listener.good());
+  const auto start = std::chrono::steady_clock::now();
+  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
+  Child feeder(TRAJROI_CLI,
+               {"feed", "--pcap", pcap.string(), "--data-port", std::to_string(rig.data_port), "--position-port",
+                std::to_string(rig.data_port + 1), "--lidar-after", "0.5"},
+               rig.feed_log);
+  ASSERT_GE(seconds_until_logged(rig.daemon_log, "withheld: no valid pose (no GNSS fix yet)", start, seconds(5)), 0.0)
+      << rig.logs();
+  trajroi::trajectory_t bad;
+  bad.id = 0;  // ids are > 0
+  bad.coordinates = trajroi::trajectory_t::GLOBAL_XY;
+  bad.num_waypoints = 2;
+  bad.u = {0.0, 10.0};
+  bad.v = {0.0, 0.0};
+  const auto sent = std::chrono::steady_clock::now();
+  listener.publish_trajectory(bad);
+  EXPECT_GE(
+      seconds_until_logged(rig.daemon_log, "trajectory on " + rig.prefix + "_TRAJECTORY rejected", sent, seconds(2)),
+      0.0)
+      << rig.logs();
+  daemon.signal(SIGTERM);
+  EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+}
+
 // The sensor's port is this daemon's alone: a second one on it stops at start, naming it.
 TEST(LiveFaults, ASecondDaemonOnTheSameLidarPortFailsAtStartNamingThePort) {
   const Rig rig("exclusive", "fixed", 10);
