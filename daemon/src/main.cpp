@@ -14,6 +14,7 @@
 int main(int argc, char** argv) {
   using namespace trajroi::daemon;
   CLI::App app{"trajroid: VLP-16 + u-blox + VN-100 in, trajectory-ROI-filtered points out over LCM"};
+  app.set_version_flag("--version", std::string("trajroid ") + TRAJROI_VERSION);
   std::string config_file;
   std::string replay, record, rate = "max", lcm_url;
   bool check_config = false, loop = false;

@@ -189,6 +189,9 @@ TEST(DaemonConfig, TheDaemonExitsWith78OnABadConfigurationAndCheckConfigPassesAG
   EXPECT_EQ(not_yaml.code, 78) << not_yaml.err;
   EXPECT_EQ(trajroid(dir / "absent.yaml").code, 78);
   EXPECT_EQ(trajroid(TRAJROI_EXAMPLE_CONFIG, "--check-config --rate sideways").code, 78);
+  // --version needs no configuration.
+  EXPECT_EQ(daemon_test::run_command(std::string(TRAJROID) + " --version | grep -qx 'trajroid " TRAJROI_VERSION "'"),
+            0);
   const DaemonRun bad_url = trajroid(TRAJROI_EXAMPLE_CONFIG, "--check-config --lcm-url udpm://239.255.76.67:99999");
   EXPECT_EQ(bad_url.code, 78);
   EXPECT_NE(bad_url.err.find("99999"), std::string::npos) << bad_url.err;

@@ -14,6 +14,12 @@
 
 namespace {
 
+TEST_F(Cli, VersionIsPrinted) {
+  const CommandResult r = run("--version");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "trajroi " TRAJROI_VERSION "\n");
+}
+
 TEST_F(Cli, FilterAppliesThePoseAndKeepsTheRightIndices) {
   const fs::path traj = write("t.csv", "# straight 10 m\n0,0\n10,0\n");
   // Robot at (5, 0) facing +y (yaw 90°): sensor (2,0) → global (5,2); (0,−4) → (9,0);

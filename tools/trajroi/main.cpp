@@ -1,11 +1,13 @@
 // trajroi: the command-line tool of the trajroi project (evaluation, filtering, dumps).
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "commands.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"trajroi — trajectory-based regions of interest for LiDAR point clouds"};
+  app.set_version_flag("--version", std::string("trajroi ") + TRAJROI_VERSION);
   app.require_subcommand(1);
   trajroi::cli::add_eval_commands(app);
   trajroi::cli::add_filter_command(app);
