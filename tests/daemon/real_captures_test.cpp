@@ -92,6 +92,29 @@ struct Rig {
     std::error_code ignored;
     fs::remove_all(dir, ignored);
   }
+  [[nodiscard]] std::vector<std::string> daemon_args() const {
+    return {"--config", config.string(), "--lcm-url", kTestLcmUrl};
+  }
+  // `trajroi feed` playing `pcap` to this rig's ports, its first datagram `lidar_after` s in.
+  [[nodiscard]] std::vector<std::string> pcap_feed(const fs::path& pcap, const std::string& lidar_after,
+                                                   std::vector<std::string> extra = {}) const {
+    std::vector<std::string> a{"feed",
+                               "--pcap",
+                               pcap.string(),
+                               "--data-port",
+                               std::to_string(data_port),
+                               "--position-port",
+                               std::to_string(data_port + 1),
+                               "--lidar-after",
+                               lidar_after};
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+  }
+  // SIGTERM: the daemon must stop cleanly.
+  void stop(Child& daemon) const {
+    daemon.signal(SIGTERM);
+    EXPECT_EQ(daemon.wait(seconds(5)), 0) << logs();
+  }
   [[nodiscard]] std::string logs() const {
     return "--- config ---\n" + slurp(config) + "--- trajroid log ---\n" + slurp(daemon_log) + "--- feed log ---\n" +
            slurp(feed_log);
@@ -112,21 +135,9 @@ TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKee
   const Rig rig(source, source, port_offset);
   Listener listener(rig.prefix);
   ASSERT_TRUE(listener.good());
-  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
+  Child daemon(rig.daemon_args(), rig.daemon_log);
 
-  std::vector<std::string> feed{"feed",
-                                "--pcap",
-                                pcap.string(),
-                                "--lidar-after",
-                                "3",
-                                "--data-port",
-                                std::to_string(rig.data_port),
-                                "--position-port",
-                                std::to_string(rig.data_port + 1),
-                                "--until",
-                                "5",
-                                "--linger",
-                                "2"};
+  std::vector<std::string> feed = rig.pcap_feed(pcap, "3", {"--until", "5", "--linger", "2"});
   if (source == std::string("gnss_imu") || source == std::string("gnss")) {
     feed.insert(feed.end(), {"--ubx", ubx.string(), "--gnss-link", rig.gnss_link.string()});
   }
@@ -177,8 +188,7 @@ TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKee
 
   ASSERT_EQ(feeder.wait(seconds(60)), 0) << rig.logs();
   std::this_thread::sleep_for(milliseconds(300));
-  daemon.signal(SIGTERM);
-  ASSERT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+  rig.stop(daemon);
 
   const auto frames = decode_capture(pcap);
   std::lock_guard<std::mutex> lock(listener.mutex);
@@ -263,14 +273,13 @@ double seconds_until_logged(const fs::path& log, const std::string& text, std::c
 TEST(LiveFaults, AMissingSerialDeviceAndASilentLidarPortAreNamedWithin5s) {
   const Rig rig("missing", "gnss_imu", 4);
   const auto start = std::chrono::steady_clock::now();
-  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
+  Child daemon(rig.daemon_args(), rig.daemon_log);
   EXPECT_LOGGED_WITHIN_5S(rig, "gnss: cannot open " + rig.gnss_link.string() + ": No such file or directory (errno 2)",
                           start);
   EXPECT_LOGGED_WITHIN_5S(rig, "imu: cannot open " + rig.imu_link.string() + ": No such file or directory (errno 2)",
                           start);
   EXPECT_LOGGED_WITHIN_5S(rig, "lidar: no datagrams for 3 s on UDP 0.0.0.0:" + std::to_string(rig.data_port), start);
-  daemon.signal(SIGTERM);
-  EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+  rig.stop(daemon);
 }
 
 TEST(LiveFaults, SwappedSerialDevicesAreNamed) {
@@ -278,7 +287,7 @@ TEST(LiveFaults, SwappedSerialDevicesAreNamed) {
   TRAJROI_REQUIRE_DATA(vn100, kVn100);
   const Rig rig("swapped", "gnss_imu", 5);
   const auto start = std::chrono::steady_clock::now();
-  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
+  Child daemon(rig.daemon_args(), rig.daemon_log);
   // The u-blox on the IMU's device, the VN-100 on the GNSS's.
   Child feeder(TRAJROI_CLI,
                {"feed", "--ubx", ubx.string(), "--gnss-link", rig.imu_link.string(), "--vn100", vn100.string(),
@@ -287,8 +296,7 @@ TEST(LiveFaults, SwappedSerialDevicesAreNamed) {
   EXPECT_LOGGED_WITHIN_5S(
       rig, "(and no UBX frame) in 3 s from " + rig.gnss_link.string() + ": gnss.device and imu.device swapped?", start);
   EXPECT_LOGGED_WITHIN_5S(rig, "UBX frames (and no VN-100 frame) in 3 s from " + rig.imu_link.string(), start);
-  daemon.signal(SIGTERM);
-  EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+  rig.stop(daemon);
 }
 
 TEST(LiveFaults, BytesThatNeverFrameSayWrongBaudRate) {
@@ -304,58 +312,45 @@ TEST(LiveFaults, BytesThatNeverFrameSayWrongBaudRate) {
     }
   }
   const auto start = std::chrono::steady_clock::now();
-  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
+  Child daemon(rig.daemon_args(), rig.daemon_log);
   Child feeder(
       TRAJROI_CLI,
       {"feed", "--vn100", noise.string(), "--imu-link", rig.gnss_link.string(), "--vn100-rate", "200", "--until", "8"},
       rig.feed_log);
   EXPECT_LOGGED_WITHIN_5S(rig, "from " + rig.gnss_link.string() + " at 115200 baud but no UBX frame: wrong baud rate?",
                           start);
-  daemon.signal(SIGTERM);
-  EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+  rig.stop(daemon);
 }
 
 TEST(LiveFaults, AnotherLidarModelIsNamedWithTheDriversReason) {
   TRAJROI_REQUIRE_DATA(hdl32e, "velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap");
   const Rig rig("model", "fixed", 7);
   const auto start = std::chrono::steady_clock::now();
-  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
-  Child feeder(TRAJROI_CLI,
-               {"feed", "--pcap", hdl32e.string(), "--data-port", std::to_string(rig.data_port), "--position-port",
-                std::to_string(rig.data_port + 1), "--lidar-after", "0.5"},
-               rig.feed_log);
+  Child daemon(rig.daemon_args(), rig.daemon_log);
+  Child feeder(TRAJROI_CLI, rig.pcap_feed(hdl32e, "0.5"), rig.feed_log);
   EXPECT_LOGGED_WITHIN_5S(rig, "(HDL-32E) is not supported", start);
   EXPECT_LOGGED_WITHIN_5S(rig, "trajroid decodes the VLP-16 only", start);
-  daemon.signal(SIGTERM);
-  EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+  rig.stop(daemon);
 }
 
 TEST(LiveFaults, DatagramsFromAnotherAddressNameTheSensorAddress) {
   TRAJROI_REQUIRE_DATA(pcap, kPcap);
   const Rig rig("sender", "fixed", 8, "  sensor_address: 127.0.0.2\n");
   const auto start = std::chrono::steady_clock::now();
-  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
-  Child feeder(TRAJROI_CLI,
-               {"feed", "--pcap", pcap.string(), "--data-port", std::to_string(rig.data_port), "--position-port",
-                std::to_string(rig.data_port + 1), "--lidar-after", "1", "--from", "127.0.0.1"},
-               rig.feed_log);
+  Child daemon(rig.daemon_args(), rig.daemon_log);
+  Child feeder(TRAJROI_CLI, rig.pcap_feed(pcap, "1", {"--from", "127.0.0.1"}), rig.feed_log);
   EXPECT_LOGGED_WITHIN_5S(rig, "none from sensor_address 127.0.0.2: is lidar.sensor_address the sensor's?", start);
-  daemon.signal(SIGTERM);
-  EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+  rig.stop(daemon);
 }
 
 TEST(LiveFaults, ATrajectoryFarFromTheRobotIsNamedWithItsDistance) {
   TRAJROI_REQUIRE_DATA(pcap, kPcap);
   const Rig rig("far", "fixed", 9, "", "{xyz: [5000, 0, 0]}");
   const auto start = std::chrono::steady_clock::now();
-  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
-  Child feeder(TRAJROI_CLI,
-               {"feed", "--pcap", pcap.string(), "--data-port", std::to_string(rig.data_port), "--position-port",
-                std::to_string(rig.data_port + 1), "--lidar-after", "0.5"},
-               rig.feed_log);
+  Child daemon(rig.daemon_args(), rig.daemon_log);
+  Child feeder(TRAJROI_CLI, rig.pcap_feed(pcap, "0.5"), rig.feed_log);
   EXPECT_LOGGED_WITHIN_5S(rig, "trajectory 0: the robot is 4996 m from it (more than 50 m)", start);
-  daemon.signal(SIGTERM);
-  EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+  rig.stop(daemon);
 }
 
 // A rejected trajectory message is said even while withheld sweeps are being warned about:
@@ -366,11 +361,8 @@ TEST(LiveFaults, ARejectedTrajectoryMessageIsSaidAmidWithheldSweepWarnings) {
   Listener listener(rig.prefix);
   ASSERT_TRUE(listener.good());
   const auto start = std::chrono::steady_clock::now();
-  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
-  Child feeder(TRAJROI_CLI,
-               {"feed", "--pcap", pcap.string(), "--data-port", std::to_string(rig.data_port), "--position-port",
-                std::to_string(rig.data_port + 1), "--lidar-after", "0.5"},
-               rig.feed_log);
+  Child daemon(rig.daemon_args(), rig.daemon_log);
+  Child feeder(TRAJROI_CLI, rig.pcap_feed(pcap, "0.5"), rig.feed_log);
   ASSERT_GE(seconds_until_logged(rig.daemon_log, "withheld: no valid pose (no GNSS fix yet)", start, seconds(5)), 0.0)
       << rig.logs();
   trajroi::trajectory_t bad;
@@ -385,18 +377,17 @@ TEST(LiveFaults, ARejectedTrajectoryMessageIsSaidAmidWithheldSweepWarnings) {
       seconds_until_logged(rig.daemon_log, "trajectory on " + rig.prefix + "_TRAJECTORY rejected", sent, seconds(2)),
       0.0)
       << rig.logs();
-  daemon.signal(SIGTERM);
-  EXPECT_EQ(daemon.wait(seconds(5)), 0) << rig.logs();
+  rig.stop(daemon);
 }
 
 // The sensor's port is this daemon's alone: a second one on it stops at start, naming it.
 TEST(LiveFaults, ASecondDaemonOnTheSameLidarPortFailsAtStartNamingThePort) {
   const Rig rig("exclusive", "fixed", 10);
-  Child first({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
+  Child first(rig.daemon_args(), rig.daemon_log);
   ASSERT_GE(seconds_until_logged(rig.daemon_log, "trajroid running", std::chrono::steady_clock::now(), seconds(5)), 0.0)
       << rig.logs();
   const fs::path second_log = rig.dir / "second.log";
-  Child second({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, second_log);
+  Child second(rig.daemon_args(), second_log);
   const int code = second.wait(seconds(5));
   EXPECT_NE(code, 0);
   EXPECT_NE(code, -1) << "the second daemon did not stop";
@@ -405,8 +396,7 @@ TEST(LiveFaults, ASecondDaemonOnTheSameLidarPortFailsAtStartNamingThePort) {
             std::string::npos)
       << said;
   EXPECT_TRUE(first.running()) << "the first daemon goes on";
-  first.signal(SIGTERM);
-  EXPECT_EQ(first.wait(seconds(5)), 0) << rig.logs();
+  rig.stop(first);
 }
 
 }  // namespace

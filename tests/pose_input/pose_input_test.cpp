@@ -34,6 +34,20 @@ TEST(ClockMap, TakesTheLeastDelayAndResetsOnAJump) {
   EXPECT_EQ(clock.resets(), 2u);
 }
 
+// A 3-D, RTK-fixed NAV-PVT epoch at this latitude/longitude (50 m high, 14 mm accuracy).
+ublox::NavPvt pvt(std::uint32_t itow_ms, double lat, double lon) {
+  ublox::NavPvt m;
+  m.itow_ms = itow_ms;
+  m.fix_type_raw = 3;
+  m.gnss_fix_ok = true;
+  m.carr_soln = ublox::CarrierSolution::kFixed;
+  m.lat_e7 = static_cast<std::int32_t>(std::llround(lat * 1e7));
+  m.lon_e7 = static_cast<std::int32_t>(std::llround(lon * 1e7));
+  m.height_mm = 50'000;
+  m.h_acc_mm = 14;
+  return m;
+}
+
 class PoseInputTest : public ::testing::Test {
  protected:
   PoseInputTest()
@@ -44,18 +58,6 @@ class PoseInputTest : public ::testing::Test {
     PoseInputConfig c;
     c.gnss_delay_ns = 30'000'000;
     return c;
-  }
-  static ublox::NavPvt pvt(std::uint32_t itow_ms, double lat, double lon) {
-    ublox::NavPvt m;
-    m.itow_ms = itow_ms;
-    m.fix_type_raw = 3;
-    m.gnss_fix_ok = true;
-    m.carr_soln = ublox::CarrierSolution::kFixed;
-    m.lat_e7 = static_cast<std::int32_t>(std::llround(lat * 1e7));
-    m.lon_e7 = static_cast<std::int32_t>(std::llround(lon * 1e7));
-    m.height_mm = 50'000;
-    m.h_acc_mm = 14;
-    return m;
   }
   pose::Geodetic origin_;
   pose::PoseBuffer buffer_;
@@ -149,14 +151,8 @@ TEST(PoseInputImu, AnyAttitudeOutputWithoutATimeFieldGivesTheAttitude) {
     config.imu_delay_ns = 4'000'000;
     pose::PoseBuffer buffer(pose::PoseGate{}, Eigen::Vector3d::Zero(), 64);
     PoseInput input(pose::GlobalFrame::local_cartesian(origin), config, buffer);
-    ublox::NavPvt m;
-    m.fix_type_raw = 3;
-    m.gnss_fix_ok = true;
-    m.lat_e7 = 360'000'000;
-    m.lon_e7 = 1'270'000'000;
-    m.h_acc_mm = 100;
     for (int k = 0; k < 3; ++k) {
-      m.itow_ms = static_cast<std::uint32_t>(1000 + 100 * k);
+      const ublox::NavPvt m = pvt(static_cast<std::uint32_t>(1000 + 100 * k), 36.0, 127.0);
       input.gnss_bytes(ublox::encode_nav_pvt(m), 1'000'000'000 + k * 100'000'000);
     }
     vn100::Sample s;
@@ -210,14 +206,7 @@ TEST(PoseInputGnss, AMovingBaseBaselineGivesTheHeadingStandingStill) {
     payload[60] = 0x05;
     payload[61] = 0x01;
     input.gnss_bytes(ublox::encode_frame(0x01, 0x3C, payload), 1'000'000'000 + k * 100'000'000);
-    ublox::NavPvt m;
-    m.itow_ms = itow;
-    m.fix_type_raw = 3;
-    m.gnss_fix_ok = true;
-    m.lat_e7 = 360'000'000;
-    m.lon_e7 = 1'270'000'000;
-    m.h_acc_mm = 100;
-    input.gnss_bytes(ublox::encode_nav_pvt(m), 1'000'000'000 + k * 100'000'000);
+    input.gnss_bytes(ublox::encode_nav_pvt(pvt(itow, 36.0, 127.0)), 1'000'000'000 + k * 100'000'000);
   }
   EXPECT_EQ(input.heading_source(), HeadingSource::kBaseline);
   // Baseline north (ENU yaw 90°) is the robot's left: the robot faces east (yaw 0).
@@ -233,12 +222,7 @@ TEST(PoseInputGnss, HeadingFromTheCourseOverGroundHeldWhenSlow) {
   config.initial_heading_deg = 180.0;  // facing south
   pose::PoseBuffer buffer(pose::PoseGate{}, Eigen::Vector3d::Zero(), 64);
   PoseInput input(pose::GlobalFrame::local_cartesian(origin), config, buffer);
-  ublox::NavPvt m;
-  m.fix_type_raw = 3;
-  m.gnss_fix_ok = true;
-  m.lat_e7 = 360'000'000;
-  m.lon_e7 = 1'270'000'000;
-  m.h_acc_mm = 100;
+  ublox::NavPvt m = pvt(0, 36.0, 127.0);
   const auto epoch = [&](int k, double speed_mps, double course_deg, double acc_deg) {
     m.itow_ms = static_cast<std::uint32_t>(1000 + 100 * k);
     m.ground_speed_mmps = static_cast<std::int32_t>(speed_mps * 1000.0);

@@ -28,6 +28,8 @@
 #include "trajroi/framing/little_endian.hpp"
 #include "trajroi/inputs/pacer.hpp"
 #include "trajroi/inputs/run_merger.hpp"
+#include "trajroi/ublox/framer.hpp"
+#include "trajroi/ublox/messages.hpp"
 #include "trajroi/vlp16/packet_source.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
 
@@ -254,47 +256,34 @@ std::vector<std::uint8_t> read_bytes(const std::string& file) {
 // travel with the chunk they sit in.
 std::vector<TimedChunk> ubx_chunks(const std::string& file) {
   const std::vector<std::uint8_t> b = read_bytes(file);
-  const bool has_eoe = [&] {
-    for (std::size_t i = 0; i + 3 < b.size(); ++i)
-      if (b[i] == 0xB5 && b[i + 1] == 0x62 && b[i + 2] == 0x01 && b[i + 3] == 0x61) return true;
-    return false;
-  }();
+  constexpr std::uint8_t kIdNavEoe = 0x61;
+  // The receiver's own framing (sync, length, checksum): the daemon's framer, a byte at a time
+  // so that each message's end is known.
+  const auto each_message = [&b](auto&& on_message) {
+    ublox::Framer framer;
+    for (std::size_t i = 0; i < b.size(); ++i)
+      framer.feed(std::span<const std::uint8_t>(&b[i], 1), [&](const ublox::Message& m) { on_message(m, i + 1); });
+  };
+  bool has_eoe = false;
+  each_message([&](const ublox::Message& m, std::size_t) {
+    has_eoe = has_eoe || (m.msg_class == ublox::kClassNav && m.msg_id == kIdNavEoe);
+  });
+  const std::uint8_t epoch_end = has_eoe ? kIdNavEoe : ublox::kIdNavPvt;
   std::vector<TimedChunk> out;
   std::size_t chunk_start = 0;
   std::optional<std::uint32_t> first_itow;
-  for (std::size_t i = 0; i + 8 <= b.size();) {
-    if (b[i] != 0xB5 || b[i + 1] != 0x62) {
-      ++i;
-      continue;
-    }
-    const std::size_t length = b[i + 4] | (static_cast<std::size_t>(b[i + 5]) << 8);
-    const std::size_t end = i + 6 + length + 2;
-    if (end > b.size()) break;
-    std::uint8_t ck_a = 0, ck_b = 0;
-    for (std::size_t k = i + 2; k < i + 6 + length; ++k) {
-      ck_a = static_cast<std::uint8_t>(ck_a + b[k]);
-      ck_b = static_cast<std::uint8_t>(ck_b + ck_a);
-    }
-    if (ck_a != b[end - 2] || ck_b != b[end - 1]) {
-      ++i;
-      continue;
-    }
-    const bool nav = b[i + 2] == 0x01;
-    const std::uint8_t id = b[i + 3];
-    if (nav && length >= 4 && (id == (has_eoe ? 0x61 : 0x07))) {
-      const std::uint32_t itow = framing::le_u32(std::span<const std::uint8_t>(b), i + 6);
-      if (!first_itow) first_itow = itow;
-      TimedChunk c;
-      c.t_ns = (static_cast<std::int64_t>(itow) - static_cast<std::int64_t>(*first_itow)) * 1'000'000;
-      c.stream = inputs::Stream::kGnss;
-      c.bytes.assign(b.begin() + static_cast<std::ptrdiff_t>(chunk_start),
-                     b.begin() + static_cast<std::ptrdiff_t>(end));
-      if (!out.empty() && c.t_ns < out.back().t_ns) c.t_ns = out.back().t_ns;  // a week wrap: keep order
-      out.push_back(std::move(c));
-      chunk_start = end;
-    }
-    i = end;
-  }
+  each_message([&](const ublox::Message& m, std::size_t end) {
+    if (m.msg_class != ublox::kClassNav || m.msg_id != epoch_end || m.payload.size() < 4) return;
+    const std::uint32_t itow = framing::le_u32(m.payload, 0);
+    if (!first_itow) first_itow = itow;
+    TimedChunk c;
+    c.t_ns = (static_cast<std::int64_t>(itow) - static_cast<std::int64_t>(*first_itow)) * 1'000'000;
+    if (!out.empty() && c.t_ns < out.back().t_ns) c.t_ns = out.back().t_ns;  // a week wrap: keep order
+    c.stream = inputs::Stream::kGnss;
+    c.bytes.assign(b.begin() + static_cast<std::ptrdiff_t>(chunk_start), b.begin() + static_cast<std::ptrdiff_t>(end));
+    out.push_back(std::move(c));
+    chunk_start = end;
+  });
   if (out.empty()) throw std::runtime_error(file + ": no UBX NAV epoch found");
   return out;
 }

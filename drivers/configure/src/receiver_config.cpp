@@ -34,13 +34,14 @@ const char* port_name(ublox::Port port) {
   return "?";
 }
 
-// Opens the port (the first read does) within the timeout; false with the reason when not.
-bool ensure_open(serial::SerialPortSource& port, std::chrono::milliseconds timeout, std::string& why) {
+// Opens the port (the first read does) within the timeout; when it does not, the failed step
+// is in `r` and false returned.
+bool ensure_open(serial::SerialPortSource& port, std::chrono::milliseconds timeout, Result& r) {
   const auto until = Clock::now() + timeout;
   serial::Chunk chunk;
   while (!port.is_open() && Clock::now() < until)
     (void)port.read(chunk, std::chrono::milliseconds(50));
-  if (!port.is_open()) why = "cannot open " + port.last_error();
+  if (!port.is_open()) r.steps.push_back({"open " + port.describe(), false, "cannot open " + port.last_error()});
   return port.is_open();
 }
 
@@ -164,11 +165,7 @@ ublox::Port guess_ublox_port(const std::string& device) noexcept {
 Result configure_ublox(serial::SerialPortSource& port, const UbloxSettings& s) {
   Result r;
   const std::string device = port.describe();
-  std::string why;
-  if (!ensure_open(port, s.timeout, why)) {
-    r.steps.push_back({"open " + device, false, why});
-    return finish(std::move(r), device);
-  }
+  if (!ensure_open(port, s.timeout, r)) return finish(std::move(r), device);
   std::vector<ublox::PoseMessage> messages{ublox::PoseMessage::kNavPvt};
   if (s.high_precision) messages.push_back(ublox::PoseMessage::kNavHpposllh);
   if (s.relposned) messages.push_back(ublox::PoseMessage::kNavRelposned);
@@ -213,11 +210,7 @@ Result configure_ublox(serial::SerialPortSource& port, const UbloxSettings& s) {
 Result configure_vn100(serial::SerialPortSource& port, const Vn100Settings& s) {
   Result r;
   const std::string device = port.describe();
-  std::string why;
-  if (!ensure_open(port, s.timeout, why)) {
-    r.steps.push_back({"open " + device, false, why});
-    return finish(std::move(r), device);
-  }
+  if (!ensure_open(port, s.timeout, r)) return finish(std::move(r), device);
   const int divisor = std::max(1, static_cast<int>(std::lround(800.0 / s.rate_hz)));
   // Common group: TimeStartup (bit 0) and YawPitchRoll (bit 3).
   const std::string command = vn100::write_binary_output(1, s.async_port, divisor, {0x0009, 0, 0, 0, 0, 0});
