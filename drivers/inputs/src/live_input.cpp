@@ -79,7 +79,7 @@ SerialInput::Next SerialInput::next(InputItem& item, std::chrono::milliseconds t
       open_failures_ = port_->counters().open_failures;
       if (port_->last_error() != reported_error_) {
         reported_error_ = port_->last_error();
-        notice_ = {Notice::Level::kWarning, name_ + ": cannot open " + reported_error_ + "; retrying until it appears"};
+        notice_ = {Notice::Level::kWarning, name_ + ": cannot open " + reported_error_ + "; retrying"};
         return Next::kNotice;
       }
     }
