@@ -108,6 +108,18 @@ ThreadConfig read_thread(MapReader& parent, std::string_view key) {
 
 }  // namespace
 
+std::optional<LcmGroup> lcm_multicast_group(const std::string& url) {
+  if (!url.starts_with("udpm://")) return std::nullopt;
+  const std::string rest = url.substr(7);
+  const std::string target = rest.substr(0, rest.find('?'));
+  LcmGroup group;
+  const std::size_t colon = target.find(':');
+  group.address = target.substr(0, colon);
+  if (group.address.empty()) group.address = "239.255.76.67";
+  if (colon != std::string::npos) group.port = std::stoi(target.substr(colon + 1));
+  return group;
+}
+
 std::string check_lcm_url(const std::string& url) {
   const std::size_t scheme_end = url.find("://");
   if (scheme_end == std::string::npos) return "must be an LCM URL, provider://[address[:port]][?options]";

@@ -1,16 +1,51 @@
 #include "log.hpp"
 
+#include <spdlog/pattern_formatter.h>
 #include <spdlog/sinks/stdout_sinks.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <cinttypes>
+#include <cstdio>
 #include <cstdlib>
 
 namespace trajroi::daemon::log {
+namespace {
+
+// Whether stderr is the journal's stream: JOURNAL_STREAM names its device and inode
+// (sd-daemon(3)); a child whose stderr was redirected inherits the variable but not the stream.
+bool stderr_is_journal() {
+  const char* stream = std::getenv("JOURNAL_STREAM");
+  if (stream == nullptr) return false;
+  std::uintmax_t device = 0, inode = 0;
+  if (std::sscanf(stream, "%" SCNuMAX ":%" SCNuMAX, &device, &inode) != 2) return false;
+  struct stat s {};
+  return fstat(STDERR_FILENO, &s) == 0 && s.st_dev == device && s.st_ino == inode;
+}
+
+// The syslog priority prefix journald reads off each stderr line ("<4>" = warning), so
+// `journalctl -p warning` finds trajroid's warnings and errors.
+class SyslogPriority final : public spdlog::custom_flag_formatter {
+ public:
+  void format(const spdlog::details::log_msg& message, const std::tm&, spdlog::memory_buf_t& out) override {
+    static constexpr char kPriority[] = {'7', '7', '6', '4', '3', '2', '6'};  // trace … critical, off
+    const char prefix[] = {'<', kPriority[static_cast<int>(message.level)], '>'};
+    out.append(prefix, prefix + 3);
+  }
+  [[nodiscard]] std::unique_ptr<custom_flag_formatter> clone() const override {
+    return std::make_unique<SyslogPriority>();
+  }
+};
+
+}  // namespace
 
 void init(const std::string& level) {
   auto logger = spdlog::stderr_logger_mt("trajroid");
-  // journald adds its own timestamps.
-  if (std::getenv("JOURNAL_STREAM") != nullptr) {
-    logger->set_pattern("%v");
+  if (stderr_is_journal()) {
+    // journald adds its own timestamps; the level travels as the line's priority.
+    auto formatter = std::make_unique<spdlog::pattern_formatter>();
+    formatter->add_flag<SyslogPriority>('*').set_pattern("%*%v");
+    logger->set_formatter(std::move(formatter));
   } else {
     logger->set_pattern("%Y-%m-%d %H:%M:%S.%e %^%-5l%$ %v");
   }

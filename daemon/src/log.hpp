@@ -10,8 +10,8 @@
 
 namespace trajroi::daemon::log {
 
-// Sets up the stderr logger. Under systemd (JOURNAL_STREAM set) lines carry no timestamp:
-// journald adds its own.
+// Sets up the stderr logger. When stderr is the journal (JOURNAL_STREAM names it) lines carry
+// no timestamp, journald adds its own, and start with their syslog priority ("<4>" warning).
 void init(const std::string& level);
 void set_level(const std::string& level);
 

@@ -20,8 +20,9 @@ class Outlet {
   using Handler = std::function<void(std::span<const std::uint8_t> bytes, const std::string& channel)>;
   virtual ~Outlet() = default;
   virtual void publish(const std::string& channel, std::span<const std::uint8_t> bytes) = 0;
-  // Incoming messages on `channel` go to `handler`, from handle_incoming() only.
-  virtual void subscribe(const std::string& channel, Handler handler) = 0;
+  // Incoming messages on `channel` go to `handler`, from handle_incoming() only. False when
+  // the transport cannot receive (LCM's self test: its own multicast does not come back).
+  virtual bool subscribe(const std::string& channel, Handler handler) = 0;
   // A descriptor readable when handle_incoming() has something to do (-1: never).
   [[nodiscard]] virtual int incoming_fd() const noexcept = 0;
   virtual void handle_incoming() = 0;
@@ -33,13 +34,14 @@ class LcmOutlet final : public Outlet {
   explicit LcmOutlet(const std::string& url);
   ~LcmOutlet() override;
   void publish(const std::string& channel, std::span<const std::uint8_t> bytes) override;
-  void subscribe(const std::string& channel, Handler handler) override;
+  bool subscribe(const std::string& channel, Handler handler) override;
   [[nodiscard]] int incoming_fd() const noexcept override;
   void handle_incoming() override;
 
  private:
   void on_message(const lcm::ReceiveBuffer* buffer, const std::string& channel);
   std::unique_ptr<lcm::LCM> lcm_;
+  bool receives_ = true;  // false: its own multicast does not come back (nothing subscribed)
   Handler handler_;
 };
 

@@ -45,7 +45,21 @@ Publisher::Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, boo
       start_steady_ns_(steady_ns()),
       health_(pipeline.config, !replay, start_steady_ns_),
       sweep_warn_limit_(pipeline.config.logging.warning_interval_s),
-      trajectory_warn_limit_(pipeline.config.logging.warning_interval_s) {}
+      trajectory_warn_limit_(pipeline.config.logging.warning_interval_s) {
+  // Here, before the loops start: LCM's first subscription runs its self test (up to seconds
+  // when its own multicast does not come back), which must not hold up the publishing loop.
+  const bool receiving = outlet_.subscribe(config_.lcm.trajectory,
+                                           [this](std::span<const std::uint8_t> bytes, const std::string& channel) {
+                                             on_trajectory_message(bytes, channel);
+                                           });
+  if (!receiving) {
+    log::error(
+        "LCM: this process does not receive its own multicast (the self test failed): trajectory messages on {} "
+        "will not arrive. Under systemd the unit's IPAddressAllow= must admit this host's addresses "
+        "(trajroid --unit-drop-in); otherwise check the multicast route and the firewall",
+        config_.lcm.trajectory);
+  }
+}
 
 void Publisher::warn_rate_limited(log::RateLimited& limit, const std::string& message) {
   std::uint64_t suppressed = 0;
@@ -215,9 +229,6 @@ void Publisher::run() {
     log::warn("{}", w);
   }
   const std::int64_t cpu_start = thread_cpu_ns();
-  outlet_.subscribe(config_.lcm.trajectory, [this](std::span<const std::uint8_t> bytes, const std::string& channel) {
-    on_trajectory_message(bytes, channel);
-  });
   latency_window_ms_.reserve(4096);
   processing_window_ms_.reserve(4096);
   latency_minute_ms_.reserve(1U << 16);

@@ -94,7 +94,7 @@ class FakeOutlet final : public trajroi::daemon::Outlet {
     std::lock_guard<std::mutex> lock(mutex_);
     messages_[channel].emplace_back(bytes.begin(), bytes.end());
   }
-  void subscribe(const std::string&, Handler) override {}
+  bool subscribe(const std::string&, Handler) override { return true; }
   [[nodiscard]] int incoming_fd() const noexcept override { return -1; }
   void handle_incoming() override {}
   std::vector<std::vector<std::uint8_t>> messages(const std::string& channel) {

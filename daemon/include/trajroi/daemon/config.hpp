@@ -155,6 +155,14 @@ struct DaemonConfig {
 // udpm an IPv4 multicast address, a port 1 … 65535, ttl 0 … 255), else what is wrong with it.
 [[nodiscard]] std::string check_lcm_url(const std::string& url);
 
+// The multicast group and port of a udpm:// URL (LCM's defaults 239.255.76.67:7667 when the URL
+// names none); nullopt for the other providers. The URL must have passed check_lcm_url.
+struct LcmGroup {
+  std::string address;
+  int port = 7667;
+};
+[[nodiscard]] std::optional<LcmGroup> lcm_multicast_group(const std::string& url);
+
 // Every effective value, one "section.key: value" line each, in config/trajroid.yaml's order
 // and units (what --check-config prints; a test compares the file's documented defaults with
 // the code's through it).
