@@ -25,11 +25,12 @@ bool stderr_is_journal() {
 
 // The syslog priority prefix journald reads off each stderr line ("<4>" = warning), so
 // `journalctl -p warning` finds trajroid's warnings and errors.
+constexpr const char* kPriority[] = {"<7>", "<7>", "<6>", "<4>", "<3>", "<2>", "<6>"};  // trace … critical, off
+
 class SyslogPriority final : public spdlog::custom_flag_formatter {
  public:
   void format(const spdlog::details::log_msg& message, const std::tm&, spdlog::memory_buf_t& out) override {
-    static constexpr char kPriority[] = {'7', '7', '6', '4', '3', '2', '6'};  // trace … critical, off
-    const char prefix[] = {'<', kPriority[static_cast<int>(message.level)], '>'};
+    const char* prefix = kPriority[static_cast<int>(message.level)];
     out.append(prefix, prefix + 3);
   }
   [[nodiscard]] std::unique_ptr<custom_flag_formatter> clone() const override {
@@ -51,6 +52,11 @@ void init(const std::string& level) {
   }
   spdlog::set_default_logger(logger);
   set_level(level);
+}
+
+const char* journal_prefix(spdlog::level::level_enum level) {
+  static const bool journal = stderr_is_journal();
+  return journal ? kPriority[static_cast<int>(level)] : "";
 }
 
 void set_level(const std::string& level) {

@@ -15,6 +15,10 @@ namespace trajroi::daemon::log {
 void init(const std::string& level);
 void set_level(const std::string& level);
 
+// For lines written to stderr before (or without) the logger: "<3>" for an error when stderr
+// is the journal, else "" (a terminal or a file gets the plain line).
+[[nodiscard]] const char* journal_prefix(spdlog::level::level_enum level);
+
 using spdlog::critical;
 using spdlog::debug;
 using spdlog::error;

@@ -1,15 +1,63 @@
 // trajroid — the trajectory-ROI daemon. See daemon/README.md and config/trajroid.yaml.
+#include <spawn.h>
+#include <sys/wait.h>
+
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "log.hpp"
 #include "reload.hpp"
 #include "trajroi/daemon/trajectory_file.hpp"
+#include "trajroi/daemon/unit_allow.hpp"
 #include "trajroid.hpp"
+
+namespace {
+
+// Said before the logger exists: the journal files these lines as errors.
+const char* error_prefix() {
+  return trajroi::daemon::log::journal_prefix(spdlog::level::err);
+}
+
+// `trajroid --apply-to-unit UNIT`: the unit's allow-lists for this configuration, set on the
+// starting unit by systemctl (run as the unit's privileged ExecStartPre).
+int apply_to_unit(const trajroi::daemon::UnitAllowLists& lists, const std::string& unit) {
+  for (const std::string& reason : lists.reasons)
+    std::printf("%s: allowing %s\n", unit.c_str(), reason.c_str());
+  for (const std::string& problem : lists.problems)
+    std::fprintf(stderr, "%s%s: %s\n", trajroi::daemon::log::journal_prefix(spdlog::level::warn), unit.c_str(),
+                 problem.c_str());
+  std::fflush(stdout);
+  const std::vector<std::string> args = trajroi::daemon::set_property_arguments(lists, unit);
+  std::vector<char*> argv;
+  for (const std::string& a : args)
+    argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t child = 0;
+  if (const int e = posix_spawnp(&child, argv[0], nullptr, nullptr, argv.data(), environ); e != 0) {
+    std::fprintf(stderr, "%strajroid: --apply-to-unit: cannot run systemctl: %s\n", error_prefix(), std::strerror(e));
+    return 1;
+  }
+  int status = 0;
+  while (waitpid(child, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    std::fprintf(stderr,
+                 "%strajroid: --apply-to-unit %s: systemctl set-property failed (status %d): the unit keeps "
+                 "its own allow-lists\n",
+                 error_prefix(), unit.c_str(), WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace trajroi::daemon;
@@ -17,7 +65,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("trajroid ") + TRAJROI_VERSION);
   std::string config_file;
   std::string replay, record, rate = "max", lcm_url;
-  bool check_config = false, loop = false;
+  std::string apply_unit;
+  bool check_config = false, loop = false, print_drop_in = false;
   app.add_option("--config", config_file, "YAML configuration (see config/trajroid.yaml)")->required();
   app.add_option("--replay", replay, "Replay a run folder (lidar.pcap, gnss.trjb, imu.trjb) instead of the sensors");
   app.add_option("--rate", rate, "Replay pace: realtime, max, or a factor of real time (e.g. 10)")
@@ -26,6 +75,11 @@ int main(int argc, char** argv) {
   app.add_option("--record", record, "Record every raw input with its host receive time into this folder");
   app.add_option("--lcm-url", lcm_url, "LCM provider URL (overrides lcm.url)");
   app.add_flag("--check-config", check_config, "Check the configuration, print a summary and exit");
+  app.add_flag("--unit-drop-in", print_drop_in,
+               "Print the systemd drop-in (IPAddressAllow=, DeviceAllow=) this configuration needs, and exit");
+  app.add_option("--apply-to-unit", apply_unit,
+                 "Set those allow-lists on UNIT for this boot (systemctl set-property --runtime), and exit: the "
+                 "unit's privileged ExecStartPre");
   double stall_after_s = -1.0;
   app.add_option("--inject-processing-stall", stall_after_s,
                  "Testing only: the processing thread stops making progress after SECONDS (watchdog test)")
@@ -40,19 +94,19 @@ int main(int argc, char** argv) {
   try {
     config = load_daemon_config(config_file);
   } catch (const trajroi::config::ConfigError& e) {
-    std::fprintf(stderr, "trajroid: configuration error: %s\n", e.what());
+    std::fprintf(stderr, "%strajroid: configuration error: %s\n", error_prefix(), e.what());
     return kExitConfig;
   }
   RunOptions options;
   if (!replay.empty()) options.replay = replay;
   if (!record.empty()) options.record = record;
   if (loop && replay.empty()) {
-    std::fprintf(stderr, "trajroid: --loop needs --replay\n");
+    std::fprintf(stderr, "%strajroid: --loop needs --replay\n", error_prefix());
     return kExitConfig;
   }
   options.loop = loop;
   if (const std::string problem = check_lcm_url(lcm_url); !lcm_url.empty() && !problem.empty()) {
-    std::fprintf(stderr, "trajroid: --lcm-url '%s': %s\n", lcm_url.c_str(), problem.c_str());
+    std::fprintf(stderr, "%strajroid: --lcm-url '%s': %s\n", error_prefix(), lcm_url.c_str(), problem.c_str());
     return kExitConfig;
   }
   options.lcm_url = lcm_url;
@@ -67,7 +121,8 @@ int main(int argc, char** argv) {
       options.rate = std::stod(rate, &used);
       if (used != rate.size() || !(options.rate > 0.0) || options.rate > 1e6) throw std::invalid_argument(rate);
     } catch (const std::exception&) {
-      std::fprintf(stderr, "trajroid: --rate: expected realtime, max or a factor > 0, got '%s'\n", rate.c_str());
+      std::fprintf(stderr, "%strajroid: --rate: expected realtime, max or a factor > 0, got '%s'\n", error_prefix(),
+                   rate.c_str());
       return kExitConfig;
     }
   }
@@ -76,9 +131,15 @@ int main(int argc, char** argv) {
   try {
     trajectory = load_trajectory(TrajectorySource::from(config));
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "trajroid: configuration error: %s: trajectory.file: %s: %s\n", config_file.c_str(),
-                 config.trajectory_file.c_str(), e.what());
+    std::fprintf(stderr, "%strajroid: configuration error: %s: trajectory.file: %s: %s\n", error_prefix(),
+                 config_file.c_str(), config.trajectory_file.c_str(), e.what());
     return kExitConfig;
+  }
+  if (print_drop_in || !apply_unit.empty()) {
+    const UnitAllowLists lists =
+        unit_allow_lists(config, lcm_url.empty() ? config.lcm.url : lcm_url, host_ipv4_addresses());
+    if (print_drop_in) std::printf("%s", unit_drop_in(lists, config_file).c_str());
+    return apply_unit.empty() ? 0 : apply_to_unit(lists, apply_unit);
   }
   if (check_config) {
     std::printf("%s", describe(config).c_str());
