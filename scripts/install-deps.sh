@@ -15,8 +15,9 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # fuzzing and sanitizers (clang's libFuzzer and runtimes); the clang build and the format check
   clang libclang-rt-14-dev clang-format
-  # systemd-analyze for the unit checks
-  systemd
+  # systemd-analyze for the unit checks; the service tests boot systemd in namespaces
+  # (unshare, nsenter: util-linux; ip: iproute2) and read lcm-logger logs with Python
+  systemd util-linux iproute2 python3
 )
 
 if [ "$(id -u)" -ne 0 ]; then

@@ -94,8 +94,20 @@ int main(int argc, char** argv) {
   try {
     config = load_daemon_config(config_file);
   } catch (const trajroi::config::ConfigError& e) {
+    if (!apply_unit.empty()) {
+      // The unit's ExecStartPre: the daemon that follows names the error and exits 78 (not
+      // restarted); failing here would have systemd restart the unit in a loop.
+      std::printf("%s: configuration error, its allow-lists are left as they are\n", apply_unit.c_str());
+      return 0;
+    }
     std::fprintf(stderr, "%strajroid: configuration error: %s\n", error_prefix(), e.what());
     return kExitConfig;
+  }
+  if (print_drop_in || !apply_unit.empty()) {
+    const UnitAllowLists lists =
+        unit_allow_lists(config, lcm_url.empty() ? config.lcm.url : lcm_url, host_ipv4_addresses());
+    if (print_drop_in) std::printf("%s", unit_drop_in(lists, config_file).c_str());
+    return apply_unit.empty() ? 0 : apply_to_unit(lists, apply_unit);
   }
   RunOptions options;
   if (!replay.empty()) options.replay = replay;
@@ -134,12 +146,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%strajroid: configuration error: %s: trajectory.file: %s: %s\n", error_prefix(),
                  config_file.c_str(), config.trajectory_file.c_str(), e.what());
     return kExitConfig;
-  }
-  if (print_drop_in || !apply_unit.empty()) {
-    const UnitAllowLists lists =
-        unit_allow_lists(config, lcm_url.empty() ? config.lcm.url : lcm_url, host_ipv4_addresses());
-    if (print_drop_in) std::printf("%s", unit_drop_in(lists, config_file).c_str());
-    return apply_unit.empty() ? 0 : apply_to_unit(lists, apply_unit);
   }
   if (check_config) {
     std::printf("%s", describe(config).c_str());

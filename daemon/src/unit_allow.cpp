@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -17,10 +18,12 @@ namespace {
 
 // The name /proc/devices gives a character device's major number ("ttyACM", "ttyTHS"…): what
 // DeviceAllow=char-NAME allows, so the device is still allowed when it comes back under
-// another minor (a USB receiver re-plugged as ttyACM1).
-std::string char_device_class(unsigned major_number) {
+// another minor (a USB receiver re-plugged as ttyACM1). A major with several names (4: tty,
+// ttyS) gives the longest that starts the node's name ("ttyS" for ttyS0).
+std::string char_device_class(unsigned major_number, const std::string& node_name) {
   std::ifstream devices("/proc/devices");
-  std::string line;
+  std::string line, best;
+  std::vector<std::string> names;
   bool in_character = false;
   while (std::getline(devices, line)) {
     if (line.starts_with("Character devices:")) {
@@ -31,10 +34,14 @@ std::string char_device_class(unsigned major_number) {
       std::istringstream fields(line);
       unsigned number = 0;
       std::string name;
-      if (fields >> number >> name && number == major_number) return name;
+      if (fields >> number >> name && number == major_number && !name.starts_with("/")) names.push_back(name);
     }
   }
-  return {};
+  for (const std::string& name : names) {
+    if (node_name.starts_with(name) && name.size() > best.size()) best = name;
+  }
+  if (best.empty() && names.size() == 1) best = names.front();
+  return best;
 }
 
 void add_unique(std::vector<std::string>& list, const std::string& entry) {
@@ -85,10 +92,15 @@ UnitAllowLists unit_allow_lists(const DaemonConfig& config, const std::string& l
       lists.problems.push_back(std::string(key) + " " + serial.device + " is not a character device");
       return;
     }
-    add_unique(lists.device_allow, serial.device + " rw");
-    const std::string name = char_device_class(major(s.st_rdev));
+    // The node itself (systemd takes only paths below /dev: a udev link like /dev/gnss is
+    // resolved to its node), and its class, which still holds when it is re-plugged.
+    std::error_code ignored;
+    const std::filesystem::path node = std::filesystem::canonical(serial.device, ignored);
+    if (node.string().starts_with("/dev/")) add_unique(lists.device_allow, node.string() + " rw");
+    const std::string name = char_device_class(major(s.st_rdev), node.filename().string());
     if (!name.empty()) add_unique(lists.device_allow, "char-" + name + " rw");
-    lists.reasons.push_back(std::string(key) + " " + serial.device + (name.empty() ? "" : " (class char-" + name + ")"));
+    lists.reasons.push_back(std::string(key) + " " + serial.device +
+                            (name.empty() ? "" : " (class char-" + name + ")"));
   };
   if (config.pose_source == PoseSource::kGnssImu || config.pose_source == PoseSource::kGnss)
     add_device(config.gnss, "gnss.device");
@@ -105,8 +117,7 @@ std::vector<std::string> host_ipv4_addresses() {
     if ((i->ifa_flags & IFF_UP) == 0 || (i->ifa_flags & IFF_LOOPBACK) != 0) continue;
     std::array<char, INET_ADDRSTRLEN> text{};
     const auto* address = reinterpret_cast<const sockaddr_in*>(i->ifa_addr);
-    if (inet_ntop(AF_INET, &address->sin_addr, text.data(), text.size()) != nullptr)
-      add_unique(addresses, text.data());
+    if (inet_ntop(AF_INET, &address->sin_addr, text.data(), text.size()) != nullptr) add_unique(addresses, text.data());
   }
   freeifaddrs(list);
   return addresses;

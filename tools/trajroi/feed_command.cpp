@@ -6,6 +6,8 @@
 // loopback interface only.
 #include <arpa/inet.h>
 #include <fcntl.h>
+#include <ifaddrs.h>
+#include <net/if.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <stdlib.h>
@@ -170,13 +172,29 @@ class PtyDevice {
   bool reopen_reported_ = false;
 };
 
+// 127.x.y.z, or an address on the loopback interface (a test's network namespace puts a
+// sensor's 10.0.0.100 there): the datagrams go to 127.0.0.1 either way and never leave.
+bool on_loopback(in_addr address) {
+  if ((ntohl(address.s_addr) >> 24) == 127) return true;
+  ifaddrs* list = nullptr;
+  if (getifaddrs(&list) != 0) return false;
+  bool found = false;
+  for (const ifaddrs* i = list; i != nullptr && !found; i = i->ifa_next) {
+    found = i->ifa_addr != nullptr && i->ifa_addr->sa_family == AF_INET && (i->ifa_flags & IFF_LOOPBACK) != 0 &&
+            reinterpret_cast<const sockaddr_in*>(i->ifa_addr)->sin_addr.s_addr == address.s_addr;
+  }
+  freeifaddrs(list);
+  return found;
+}
+
 class UdpSender {
  public:
   explicit UdpSender(const std::string& from) {
     sockaddr_in source{};
     source.sin_family = AF_INET;
-    if (inet_pton(AF_INET, from.c_str(), &source.sin_addr) != 1 || (ntohl(source.sin_addr.s_addr) >> 24) != 127) {
-      throw std::invalid_argument("feed sends on loopback only: '" + from + "' is not a 127.x.y.z address");
+    if (inet_pton(AF_INET, from.c_str(), &source.sin_addr) != 1 || !on_loopback(source.sin_addr)) {
+      throw std::invalid_argument("feed sends on loopback only: '" + from +
+                                  "' is neither a 127.x.y.z address nor one on the loopback interface");
     }
     fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
     if (fd_ < 0 || ::bind(fd_, reinterpret_cast<const sockaddr*>(&source), sizeof source) != 0) {

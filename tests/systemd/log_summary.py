@@ -1,0 +1,31 @@
+"""What an lcm-logger log of trajroid holds, read with the installed Python types:
+one line per channel "CHANNEL TYPE COUNT", then "points_with_valid_pose N" and
+"last_trajectory_id K" (from the last status_t) and "roi_heading_deg MIN MAX" (the
+trajectory's heading at the ROI centres of every roi_t)."""
+import math
+import sys
+
+import trajroi_lcm
+
+counts = {}
+valid = 0
+last_trajectory = -1
+headings = []
+for channel, _timestamp, data in trajroi_lcm.read_log(sys.argv[1]):
+    if channel == "LCM_SELF_TEST":  # liblcm's own, at each client's start
+        continue
+    message = trajroi_lcm.decode(data)
+    name = type(message).__name__
+    counts[(channel, name)] = counts.get((channel, name), 0) + 1
+    if name == "points_t" and message.pose.valid:
+        valid += 1
+    if name == "roi_t":
+        headings += [math.degrees(t) for t in message.theta_rad]
+    if name == "status_t":
+        last_trajectory = message.trajectory_id
+for (channel, name), count in sorted(counts.items()):
+    print("%s %s %d" % (channel, name, count))
+print("points_with_valid_pose %d" % valid)
+print("last_trajectory_id %d" % last_trajectory)
+if headings:
+    print("roi_heading_deg %.2f %.2f" % (min(headings), max(headings)))
