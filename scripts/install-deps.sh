@@ -18,6 +18,8 @@ packages=(
   # systemd-analyze for the unit checks; the service tests boot systemd in namespaces
   # (unshare, nsenter: util-linux; ip: iproute2) and read lcm-logger logs with Python
   systemd util-linux iproute2 python3
+  # the man pages (from --help) and the .deb (cpack: dpkg-shlibdeps)
+  help2man dpkg-dev
 )
 
 if [ "$(id -u)" -ne 0 ]; then

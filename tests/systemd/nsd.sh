@@ -99,8 +99,8 @@ nsd_drop_in() {
   nsd systemctl daemon-reload
 }
 
+# Idempotent: the exit trap calls it again.
 nsd_end() {
-  trap - EXIT
   if [ -n "$NSD_PID1" ]; then
     kill -KILL "$NSD_PID1" 2>/dev/null || true
   fi
