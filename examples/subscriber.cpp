@@ -15,5 +15,6 @@ int main(int argc, char** argv) {
   lcm::LCM lcm(argc > 1 ? argv[1] : "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608");
   Printer printer;
   lcm.subscribe("TRAJROI_POINTS", &Printer::on_points, &printer);
-  while (lcm.handle() == 0) continue;
+  while (lcm.handle() == 0)
+    continue;
 }

@@ -3,9 +3,11 @@
 # (PID 1 of private namespaces, tests/systemd/nsd.sh) as the installed unit with the installed
 # configuration, fed a real VLP-16 capture, stopped, and purged: nothing of it left behind.
 # The machine's net.core.rmem_* (set by the package's postinst) are put back at the end.
-# Usage: deb_test.sh BUILD WORK DATA_DIR
+# With SPY_CHECK_CLASSPATH (tools/spy's check, the build's type jar, lcm.jar): every channel
+# of a replay through the installed daemon decodes in lcm-spy's way with the installed jar.
+# Usage: deb_test.sh BUILD WORK DATA_DIR [SPY_CHECK_CLASSPATH]
 set -euo pipefail
-build=$1 work=$2 data_dir=$(cd "$3" 2>/dev/null && pwd || echo "$3")
+build=$1 work=$2 data_dir=$(cd "$3" 2>/dev/null && pwd || echo "$3") spy_classpath=${4:-}
 here=$(cd "$(dirname "$0")" && pwd)
 # shellcheck source=../systemd/nsd.sh
 source "$here/../systemd/nsd.sh"
@@ -62,6 +64,27 @@ if [ -f "$pcap" ]; then
 elif [ "${CI:-}" = true ]; then
   fail "$pcap missing"
 fi
+
+if [ -n "$spy_classpath" ] && command -v java >/dev/null; then
+  # The build's type jar swapped for the installed one.
+  classpath=$(tr ':' '\n' <<<"$spy_classpath" | sed 's|.*/trajroi_lcmtypes\.jar$|/usr/share/java/trajroi_lcmtypes.jar|' | paste -sd:)
+  /usr/bin/trajroi sim --quiet --scenario "$here/../daemon/corridor.yaml" --out "$work/run" >/dev/null 2>&1
+  unshare --net /bin/bash -c '
+    set -euo pipefail
+    ip link set lo up
+    ip link set lo multicast on
+    ip route add 224.0.0.0/4 dev lo src 127.0.0.1
+    url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608"
+    java -cp "$2" SpyDecodeCheck "$url" 12 TRAJROI_POINTS TRAJROI_POSE TRAJROI_ROI TRAJROI_STATUS >"$1/spy.txt" 2>&1 &
+    check=$!
+    sleep 2
+    /usr/bin/trajroid --config "$1/run/trajroid.yaml" --replay "$1/run" --rate 4 2>"$1/replay.log"
+    wait "$check"' _ "$work" "$classpath" || fail "a channel does not decode with the installed jar: $(cat "$work/spy.txt")"
+  grep -E "decoded|no message" "$work/spy.txt" | sed 's/^/installed jar, lcm-spy decoding: /'
+elif [ "${CI:-}" = true ]; then
+  fail "no Java or no spy check: the installed jar is not checked"
+fi
+
 start_ns=$(date +%s%N)
 nsd systemctl stop trajroid.service
 echo "stop: $((($(date +%s%N) - start_ns) / 1000000)) ms, result $(nsd systemctl show trajroid.service -p Result --value)"

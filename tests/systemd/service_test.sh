@@ -194,8 +194,16 @@ YAML
   }
   install_unit "$work/trajroid.yaml"
 
+  hand_to_dialout() {
+    local link
+    for link in "$@"; do
+      chgrp dialout "$(readlink -f "$link")"
+      chmod 0660 "$(readlink -f "$link")"
+    done
+  }
   # The control: without its allow-list step, the unit's fixed list (localhost, 192.168/16)
-  # drops the sensor's datagrams.
+  # drops the sensor's datagrams. (Pseudo-terminals need no DeviceAllow=: systemd's
+  # DevicePolicy=closed always admits char-pts; the step adds the devices' class anyway.)
   printf '[Service]\nExecStartPre=\n' | nsd_drop_in trajroid.service no-allow-step
   nsd systemctl start trajroid.service || fail "start (control)"
   nsd "$trajroi" feed --pcap "$pcap" --from 10.0.0.100 --until 2 >"$work/feed-control.log" 2>&1 ||
@@ -216,10 +224,7 @@ YAML
     --ubx "$ubx" --gnss-link "$work/gnss" --vn100 "$vn100" --imu-link "$work/imu" >"$work/feed.log" 2>&1 &
   feed_pid=$!
   wait_for 10 test -L "$work/gnss" -a -L "$work/imu" || fail "the feed made no devices: $(cat "$work/feed.log")"
-  for link in "$work/gnss" "$work/imu"; do
-    chgrp dialout "$(readlink -f "$link")"
-    chmod 0660 "$(readlink -f "$link")"
-  done
+  hand_to_dialout "$work/gnss" "$work/imu"
   nsd timeout -s INT 25 lcm-logger --quiet "$work/out.lcmlog" >"$work/logger.log" 2>&1 &
   logger_pid=$!
   sleep 0.5

@@ -202,6 +202,13 @@ bool SerialPortSource::try_open() {
     if (error.empty()) port_ = std::move(tty);
   }
   if (!port_) {
+    // Permission bits that allow it and an open that is refused: a device cgroup (systemd's
+    // DevicePolicy=closed without the device in DeviceAllow=).
+    if (error.find(std::strerror(EPERM)) != std::string::npos) {
+      error +=
+          " (not in the device allow-list: under systemd, the unit's DeviceAllow= must list it; "
+          "`trajroid --unit-drop-in` prints what the configuration needs)";
+    }
     last_error_ = options_.device + ": " + error;
     ++counters_.open_failures;
     next_open_ns_ = monotonic_now_ns() + std::chrono::duration_cast<std::chrono::nanoseconds>(backoff_).count();
