@@ -103,12 +103,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%strajroid: configuration error: %s\n", error_prefix(), e.what());
     return kExitConfig;
   }
-  if (print_drop_in || !apply_unit.empty()) {
-    const UnitAllowLists lists =
-        unit_allow_lists(config, lcm_url.empty() ? config.lcm.url : lcm_url, host_ipv4_addresses());
-    if (print_drop_in) std::printf("%s", unit_drop_in(lists, config_file).c_str());
-    return apply_unit.empty() ? 0 : apply_to_unit(lists, apply_unit);
-  }
   RunOptions options;
   if (!replay.empty()) options.replay = replay;
   if (!record.empty()) options.record = record;
@@ -120,6 +114,12 @@ int main(int argc, char** argv) {
   if (const std::string problem = check_lcm_url(lcm_url); !lcm_url.empty() && !problem.empty()) {
     std::fprintf(stderr, "%strajroid: --lcm-url '%s': %s\n", error_prefix(), lcm_url.c_str(), problem.c_str());
     return kExitConfig;
+  }
+  if (print_drop_in || !apply_unit.empty()) {
+    const UnitAllowLists lists =
+        unit_allow_lists(config, lcm_url.empty() ? config.lcm.url : lcm_url, host_ipv4_addresses());
+    if (print_drop_in) std::printf("%s", unit_drop_in(lists, config_file).c_str());
+    return apply_unit.empty() ? 0 : apply_to_unit(lists, apply_unit);
   }
   options.lcm_url = lcm_url;
   if (stall_after_s >= 0.0) options.stall_processing_after_s = stall_after_s;
