@@ -29,15 +29,15 @@ TEST(UnitAllow, TheSensorTheLcmGroupAndThisHostsAddressesAreAllowedAndNothingEls
   EXPECT_NE(drop_in.find("# allows the LiDAR at 10.0.0.100 (lidar.sensor_address)"), std::string::npos) << drop_in;
   const auto args = trajroi::daemon::set_property_arguments(l, "trajroid.service");
   EXPECT_EQ(std::vector<std::string>(args.begin(), args.begin() + 6),
-            (std::vector<std::string>{"systemctl", "set-property", "--runtime", "trajroid.service", "IPAddressAllow=",
-                                      "IPAddressAllow=localhost"}));
+            (std::vector<std::string>{"systemctl", "set-property", "--runtime", "trajroid.service",
+                                      "IPAddressAllow=", "IPAddressAllow=localhost"}));
 }
 
 TEST(UnitAllow, AnySenderAdmitsThePrivateAndLinkLocalRangesAndAnotherProviderNoGroup) {
   DaemonConfig c;
   const UnitAllowLists l = trajroi::daemon::unit_allow_lists(c, "memq://", {"192.0.2.2"});
-  EXPECT_EQ(l.ip_allow, (std::vector<std::string>{"localhost", "10.0.0.0/8", "172.16.0.0/12", "192.168.0.0/16",
-                                                  "169.254.0.0/16"}));
+  EXPECT_EQ(l.ip_allow,
+            (std::vector<std::string>{"localhost", "10.0.0.0/8", "172.16.0.0/12", "192.168.0.0/16", "169.254.0.0/16"}));
 }
 
 TEST(UnitAllow, SerialDevicesAreAllowedByNodeAndClassALinkByItsNodeAMissingOneIsAProblem) {
