@@ -30,6 +30,9 @@ figures() {  # rate → "latency_p50 latency_p99 drops wall_s cpu_s pipeline_cpu
 }
 
 echo "scenario: tests/daemon/corridor.yaml, dual return, ${duration} s of data"
+# Where these figures come from: the CPU, its cores, and the ROI scan trajroid calibrated.
+scan=$("$build/daemon/trajroid" --config "$run/trajroid.yaml" --replay "$run" --rate max 2>&1 | grep "roi scan for" || true)
+echo "machine and scan: ${scan#*roi scan for }"
 read -r p50 p99 drops wall cpu pipeline < <(figures realtime)
 echo "real-time replay: latency last packet → LCM p50 ${p50} ms, p99 ${p99} ms (goal p99 <= 2 ms); ring drops ${drops} (goal 0)"
 awk -v c="$cpu" -v p="$pipeline" -v d="$duration" 'BEGIN {

@@ -4,8 +4,10 @@
 // Names: roi/<circular|rectangular>/<reference|fast>/<frame|accumulated>/<25|10>
 //        limit/<read|memcpy>/<frame|accumulated>
 // Each fast iteration rebuilds the grid, as the daemon does for every sweep.
-// TRAJROI_SIMD=avx512|avx2|sse2|scalar forces the fast filter's scan (default: the widest the
-// CPU has), to measure what a CPU without AVX-512 would see.
+// The fast filter runs the scan GridFilter::calibrate() found fastest on this machine for each
+// shape (as the daemon does at start); TRAJROI_SIMD=avx512|avx2|sse2|scalar forces one, to
+// compare them. The context printed first names the CPU, the cores and each shape's scan with
+// the calibration's times.
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
@@ -14,6 +16,7 @@
 #include <limits>
 #include <string>
 
+#include "machine_context.hpp"
 #include "synthetic_cloud.hpp"
 #include "trajroi/roi/grid_filter.hpp"
 #include "trajroi/roi/reference_filter.hpp"
@@ -38,21 +41,14 @@ const std::vector<roi::PointXYZI>& cloud(bool accumulated) {
   return accumulated ? many : frame;
 }
 
-roi::SimdPath simd_path() {
-  static const roi::SimdPath path = [] {
-    const char* name = std::getenv("TRAJROI_SIMD");
-    const std::string wanted = name == nullptr ? "" : name;
-    if (wanted == "avx512") return roi::SimdPath::kAvx512;
-    if (wanted == "avx2") return roi::SimdPath::kAvx2;
-    if (wanted == "sse2") return roi::SimdPath::kSse2;
-    if (wanted == "scalar") return roi::SimdPath::kScalar;
-    if (!wanted.empty() && wanted != "auto") {
-      std::fprintf(stderr, "roi_bench: TRAJROI_SIMD=%s is not auto, avx512, avx2, sse2 or scalar\n", wanted.c_str());
-      std::exit(2);
-    }
-    return roi::SimdPath::kAuto;
-  }();
-  return path;
+// A bad TRAJROI_SIMD stops the benchmark before any run.
+void check_simd_variable() {
+  const char* name = std::getenv("TRAJROI_SIMD");
+  roi::SimdPath path = roi::SimdPath::kAuto;
+  if (name != nullptr && !roi::simd_path_from_string(name, path)) {
+    std::fprintf(stderr, "roi_bench: TRAJROI_SIMD=%s is not auto, avx512, avx2, sse2 or scalar\n", name);
+    std::exit(2);
+  }
 }
 
 const roi::Trajectory& trajectory() {
@@ -111,7 +107,7 @@ void fast(benchmark::State& state, bool accumulated, int ratio_pct) {
   kept.reserve(points.size());
   for (auto _ : state) {
     grid.build(set);
-    grid.filter(std::span<const roi::PointXYZI>(points), kept, simd_path());
+    grid.filter(std::span<const roi::PointXYZI>(points), kept);
     benchmark::DoNotOptimize(kept.data());
     benchmark::ClobberMemory();
   }
@@ -142,8 +138,33 @@ void limit_memcpy(benchmark::State& state, bool accumulated) {
   set_counters(state, points.size(), 0, 0);
 }
 
+// Calibrates the shape's scan on its 25 % chain (what the daemon does at start) and says the
+// choice in the benchmark's context.
+template <typename RoiSet>
+void calibrate(const char* shape) {
+  const RoiSet set = make_set<RoiSet>(25);
+  roi::GridFilter<RoiSet> grid;
+  grid.build(set);
+  const roi::ScanCalibration c = grid.calibrate();
+  std::string text = roi::to_string(c.chosen);
+  if (c.forced) {
+    text += " (forced by TRAJROI_SIMD)";
+  } else {
+    text += " (ns per point:";
+    for (const roi::SimdPath path :
+         {roi::SimdPath::kAvx512, roi::SimdPath::kAvx2, roi::SimdPath::kSse2, roi::SimdPath::kScalar}) {
+      const double ns = c.ns_per_point[static_cast<int>(path)];
+      if (ns >= 0.0) text += std::string(" ") + roi::to_string(path) + " " + std::to_string(ns).substr(0, 5);
+    }
+    text += ")";
+  }
+  benchmark::AddCustomContext(std::string("scan_") + shape, text);
+}
+
 int register_all() {
-  (void)simd_path();  // a bad TRAJROI_SIMD stops here, before any run
+  check_simd_variable();
+  calibrate<roi::CircularRoiSet>("circular");
+  calibrate<roi::RectangularRoiSet>("rectangular");
   for (const bool accumulated : {false, true}) {
     const std::string where = accumulated ? "accumulated" : "frame";
     const auto unit = accumulated ? benchmark::kMillisecond : benchmark::kMicrosecond;

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "machine_context.hpp"
 #include "trajroi/ublox/framer.hpp"
 #include "trajroi/ublox/messages.hpp"
 #include "trajroi/vn100/decoder.hpp"

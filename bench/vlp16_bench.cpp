@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "machine_context.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
 #include "trajroi/vlp16/stream_decoder.hpp"
 

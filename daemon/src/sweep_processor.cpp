@@ -136,6 +136,10 @@ SweepProcessor::SweepProcessor(const DaemonConfig& config, std::unique_ptr<Activ
 
 SweepProcessor::~SweepProcessor() = default;
 
+roi::ScanCalibration SweepProcessor::calibrate_scan() const {
+  return config_.roi.shape == RoiShape::kCircular ? circle_grid_.calibrate() : rect_grid_.calibrate();
+}
+
 void SweepProcessor::lidar_datagram(LidarPort port, std::span<const std::uint8_t> payload, std::int64_t receive_ns,
                                     SweepSink& sink) {
   if (port == LidarPort::kPosition) {

@@ -21,6 +21,7 @@
 #include "trajroi/configure/receiver_config.hpp"
 #include "trajroi/inputs/live_input.hpp"
 #include "trajroi/inputs/recorded_input.hpp"
+#include "trajroi/roi/cpu.hpp"
 
 namespace trajroi::daemon {
 
@@ -95,6 +96,24 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
                                                       config.lcm.pose_input),
                        config.buffers.serial_chunks, "trajroid-posein", config.realtime.gnss);
   }
+}
+
+// The ROI scan this machine runs fastest, with what was measured and where.
+void log_scan_calibration(const roi::ScanCalibration& c, RoiShape shape) {
+  const char* shape_name = shape == RoiShape::kCircular ? "circles" : "rectangles";
+  if (c.forced) {
+    log::info("roi scan for {}: {} (forced by TRAJROI_SIMD) on {}", shape_name, roi::to_string(c.chosen),
+              roi::describe_machine());
+    return;
+  }
+  std::string times;
+  for (const roi::SimdPath path :
+       {roi::SimdPath::kAvx512, roi::SimdPath::kAvx2, roi::SimdPath::kSse2, roi::SimdPath::kScalar}) {
+    const double ns = c.ns_per_point[static_cast<int>(path)];
+    if (ns >= 0.0) times += fmt::format("{}{} {:.2f}", times.empty() ? "" : ", ", roi::to_string(path), ns);
+  }
+  log::info("roi scan for {}: {} ({} ns per point) on {}", shape_name, roi::to_string(c.chosen), times,
+            roi::describe_machine());
 }
 
 // Signals go to the main thread only, through a signalfd (-1 when not handled).
@@ -199,6 +218,7 @@ int run_daemon(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> tra
     log::critical("{}: {}", config.file.string(), e.what());
     return kExitConfig;
   }
+  log_scan_calibration(processor->calibrate_scan(), config.roi.shape);
   const bool exact = options.replay.has_value() && options.rate == 0.0;
   Pipeline pipeline(config, exact, options.record.has_value());
   try {

@@ -4,13 +4,131 @@
 #include "trajroi/roi/grid_filter.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <numbers>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 #endif
 
 namespace trajroi::roi {
+
+const char* to_string(SimdPath path) noexcept {
+  switch (path) {
+    case SimdPath::kAvx512:
+      return "avx512";
+    case SimdPath::kAvx2:
+      return "avx2";
+    case SimdPath::kSse2:
+      return "sse2";
+    case SimdPath::kScalar:
+      return "scalar";
+    case SimdPath::kAuto:
+      break;
+  }
+  return "auto";
+}
+
+bool simd_path_from_string(const char* text, SimdPath& path) noexcept {
+  for (const SimdPath p : {SimdPath::kAuto, SimdPath::kAvx512, SimdPath::kAvx2, SimdPath::kSse2, SimdPath::kScalar}) {
+    if (std::strcmp(text, to_string(p)) == 0) {
+      path = p;
+      return true;
+    }
+  }
+  if (*text != '\0') return false;
+  path = SimdPath::kAuto;
+  return true;
+}
+
+bool cpu_has(SimdPath path) noexcept {
+#if defined(__x86_64__) || defined(__i386__)
+  switch (path) {
+    case SimdPath::kAvx512:
+      return __builtin_cpu_supports("avx512f");
+    case SimdPath::kAvx2:
+      return __builtin_cpu_supports("avx2");
+    case SimdPath::kSse2:
+      return true;  // every x86-64
+    case SimdPath::kScalar:
+    case SimdPath::kAuto:
+      return true;
+  }
+  return false;
+#else
+  return path == SimdPath::kScalar || path == SimdPath::kAuto;
+#endif
+}
+
+template <typename RoiSet>
+SimdPath GridFilter<RoiSet>::auto_path() noexcept {
+  return auto_path_.load(std::memory_order_relaxed);
+}
+
+template <typename RoiSet>
+ScanCalibration GridFilter<RoiSet>::calibrate() const {
+  ScanCalibration result;
+  if (rois_ == nullptr) return result;  // not built: nothing to time on
+  if (const char* forced = std::getenv("TRAJROI_SIMD"); forced != nullptr && *forced != '\0') {
+    SimdPath path = SimdPath::kAuto;
+    if (simd_path_from_string(forced, path) && path != SimdPath::kAuto) {
+      result.chosen = path;
+      result.forced = true;
+      auto_path_.store(path, std::memory_order_relaxed);
+      return result;
+    }
+  }
+  // A LiDAR-like cloud over the grid, in firing order: 16 lasers on rings about the grid's
+  // centre, 0.2° apart in azimuth, so consecutive firings mostly land in the same cells as
+  // real sweeps do (what the scans' cell reuse is for); the rings reach the grid's corners.
+  const double h = cell_size_m_;
+  const double cx = static_cast<double>(x0_) + 0.5 * h * static_cast<double>(nx_);
+  const double cy = static_cast<double>(y0_) + 0.5 * h * static_cast<double>(ny_);
+  const double reach = 0.5 * h * std::hypot(static_cast<double>(nx_), static_cast<double>(ny_));
+  const ZLimits& z_limits = rois_ != nullptr ? rois_->z_limits() : ZLimits{};
+  const double z =
+      std::isfinite(z_limits.min_m) && std::isfinite(z_limits.max_m)
+          ? 0.5 * (z_limits.min_m + z_limits.max_m)
+          : (std::isfinite(z_limits.min_m) ? z_limits.min_m : (std::isfinite(z_limits.max_m) ? z_limits.max_m : 0.0));
+  constexpr std::size_t kFirings = 1800;  // one turn
+  constexpr std::size_t kLasers = 16;
+  std::vector<PointXYZI> cloud;
+  cloud.reserve(kFirings * kLasers);
+  for (std::size_t f = 0; f < kFirings; ++f) {
+    const double azimuth = 2.0 * std::numbers::pi * static_cast<double>(f) / static_cast<double>(kFirings);
+    for (std::size_t l = 0; l < kLasers; ++l) {
+      const double ring = reach * static_cast<double>(l + 1) / static_cast<double>(kLasers);
+      const double r = ring * (1.0 + 0.05 * std::sin(7.0 * azimuth + static_cast<double>(l)));
+      cloud.push_back({static_cast<float>(cx + r * std::cos(azimuth)), static_cast<float>(cy + r * std::sin(azimuth)),
+                       static_cast<float>(z), 0.0f});
+    }
+  }
+  IndexVector kept;
+  kept.reserve(cloud.size());
+  const std::span<const PointXYZI> points(cloud);
+  double best = std::numeric_limits<double>::infinity();
+  for (const SimdPath path : {SimdPath::kAvx512, SimdPath::kAvx2, SimdPath::kSse2, SimdPath::kScalar}) {
+    if (!cpu_has(path)) continue;
+    double fastest = std::numeric_limits<double>::infinity();
+    for (int run = 0; run < 7; ++run) {
+      const auto start = std::chrono::steady_clock::now();
+      (void)filter(points, kept, path);
+      const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count();
+      fastest = std::min(fastest, ns / static_cast<double>(points.size()));
+    }
+    result.ns_per_point[static_cast<int>(path)] = fastest;
+    // A narrower scan must be clearly faster (3 %) to be chosen over a wider one.
+    if (fastest < best * 0.97) {
+      best = fastest;
+      result.chosen = path;
+    }
+  }
+  auto_path_.store(result.chosen, std::memory_order_relaxed);
+  return result;
+}
 
 template <typename RoiSet>
 void GridFilter<RoiSet>::build(const RoiSet& rois) {
@@ -230,6 +348,7 @@ FilterStats GridFilter<RoiSet>::filter(std::span<const Point> points, IndexVecto
   std::size_t i = 0;
   if constexpr (std::is_same_v<Point, PointXYZI>) {
 #if defined(__x86_64__) || defined(__i386__)
+    if (path == SimdPath::kAuto) path = auto_path_.load(std::memory_order_relaxed);
     const bool wide = path == SimdPath::kAuto || path == SimdPath::kAvx512;
     if (wide && __builtin_cpu_supports("avx512f")) {
       i = scan_avx512(points, scan);

@@ -141,6 +141,11 @@ class SweepProcessor {
   SweepProcessor(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> trajectory);
   ~SweepProcessor();
 
+  // Times the ROI filter's scans for the configured shape on its start-up grid and makes
+  // the fastest on this machine the one used (roi::GridFilter::calibrate); at start, before
+  // the first sweep.
+  roi::ScanCalibration calibrate_scan() const;
+
   void lidar_datagram(LidarPort port, std::span<const std::uint8_t> payload, std::int64_t receive_ns, SweepSink& sink);
   void gnss_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) {
     pose_input_.gnss_bytes(bytes, receive_ns);

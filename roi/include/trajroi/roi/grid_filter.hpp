@@ -1,6 +1,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -17,6 +18,20 @@
 namespace trajroi::roi {
 
 enum class SimdPath : unsigned char { kAuto, kAvx512, kAvx2, kSse2, kScalar };
+
+[[nodiscard]] const char* to_string(SimdPath path) noexcept;
+// "avx512", "avx2", "sse2", "scalar" or "auto" (also empty) → the path; false for anything else.
+[[nodiscard]] bool simd_path_from_string(const char* text, SimdPath& path) noexcept;
+// Whether this CPU can run the path (kAuto and kScalar: always).
+[[nodiscard]] bool cpu_has(SimdPath path) noexcept;
+
+// What GridFilter::calibrate() measured: nanoseconds per point of each scan on this machine
+// (indexed by SimdPath; negative for a scan the CPU lacks) and the one kAuto now runs.
+struct ScanCalibration {
+  SimdPath chosen = SimdPath::kAuto;
+  bool forced = false;  // TRAJROI_SIMD named the path: nothing was timed
+  double ns_per_point[5] = {-1.0, -1.0, -1.0, -1.0, -1.0};
+};
 
 // The float nearest to v on the given side (v itself when exactly representable).
 [[nodiscard]] inline float float_at_or_below(double v) noexcept {
@@ -72,10 +87,21 @@ class GridFilter {
 
   // `path` chooses the implementation of the per-point scan for PointXYZI clouds (other point
   // types always take the scalar path); every path gives the same result. kAuto takes the
-  // widest the CPU supports; the others exist so tests can check each one (a path the CPU
-  // lacks falls back to the next narrower one).
+  // one calibrate() found fastest, else the widest the CPU supports; the others exist so
+  // tests and benchmarks can run each one (a path the CPU lacks falls back to the next
+  // narrower one).
   template <typename Point>
   FilterStats filter(std::span<const Point> points, IndexVector& kept, SimdPath path = SimdPath::kAuto) const;
+
+  // Which scan is fastest depends on the processor, not only on what it supports (the AVX2
+  // scan's gathers are slower than SSE2 on some AMD Zen for rectangles). Times each scan the
+  // CPU has on a synthetic LiDAR-like cloud laid over this (built) grid, best of several
+  // runs, and makes the fastest the one kAuto runs for this shape, process-wide, from then on.
+  // TRAJROI_SIMD=avx512|avx2|sse2|scalar in the environment forces a path instead (tests,
+  // benchmarks). Thread-safe; a few milliseconds. Until it is called kAuto runs the widest.
+  ScanCalibration calibrate() const;
+  // The scan kAuto runs now for this shape.
+  [[nodiscard]] static SimdPath auto_path() noexcept;
 
   [[nodiscard]] std::size_t cell_count() const noexcept { return nx_ * ny_; }
   [[nodiscard]] std::size_t boundary_cell_count() const noexcept { return offsets_.empty() ? 0 : offsets_.size() - 1; }
@@ -115,6 +141,7 @@ class GridFilter {
   // Index into cells_ of the cell holding (x, y); the sentinel when off the grid.
   [[nodiscard]] std::size_t cell_index(float x, float y) const noexcept;
 
+  static inline std::atomic<SimdPath> auto_path_{SimdPath::kAuto};  // set by calibrate()
   const RoiSet* rois_ = nullptr;
   float x0_ = 0.0f;  // grid origin (global frame, m)
   float y0_ = 0.0f;

@@ -1,0 +1,16 @@
+#pragma once
+
+// The machine the scans run on, for the figures that depend on it (benchmarks, the daemon's
+// scan calibration line): the CPU's model name and the cores this process may use.
+#include <string>
+
+namespace trajroi::roi {
+
+// /proc/cpuinfo's "model name" (x86) or "Model"/"CPU part" line; "unknown CPU" without one.
+[[nodiscard]] std::string cpu_model();
+// The cores this process may run on (its affinity mask).
+[[nodiscard]] unsigned usable_cores();
+// "Intel(R) Xeon(R) …, 2 cores, AVX-512 AVX2 SSE2": model, cores and the scans the CPU has.
+[[nodiscard]] std::string describe_machine();
+
+}  // namespace trajroi::roi
