@@ -7,7 +7,8 @@
 #
 # The namespace gets its own /tmp and /run (tmpfs) before anything else: systemd-tmpfiles
 # empties /tmp at boot, and must never see the machine's. Its journal and the /var folders a
-# DynamicUser service writes are tmpfs of its own as well. Its network is a loopback of its own,
+# DynamicUser service writes are tmpfs of its own as well, and the units that would change the
+# machine itself (sysctl, modules, binfmt, users, tmpfiles, udev) are masked. Its network is a loopback of its own,
 # up, with the multicast route LCM needs and the addresses in NSD_ADDRESSES (default none) on it.
 # Needs root, unshare/nsenter (util-linux), ip (iproute2) and /lib/systemd/systemd.
 
@@ -48,6 +49,18 @@ nsd_boot() {
         dir=${spec%:*}
         [ -d "$dir" ] || mkdir -p -m "${spec#*:}" "$dir"
         mount -t tmpfs -o "mode=${spec#*:}" tmpfs "$dir"
+      done
+      # Units that would change the machine rather than the namespace (kernel modules, binfmt,
+      # sysctl, users, tmpfiles in /etc and /var, udev, the root mount) are masked.
+      mkdir -p /run/systemd/system
+      for unit in systemd-sysctl.service systemd-modules-load.service kmod-static-nodes.service \
+                  systemd-binfmt.service proc-sys-fs-binfmt_misc.automount systemd-sysusers.service \
+                  systemd-tmpfiles-setup.service systemd-tmpfiles-setup-dev.service systemd-tmpfiles-clean.timer \
+                  systemd-remount-fs.service systemd-udevd.service systemd-udev-trigger.service \
+                  systemd-hwdb-update.service systemd-random-seed.service systemd-update-utmp.service \
+                  systemd-firstboot.service systemd-machine-id-commit.service ldconfig.service \
+                  systemd-journal-catalog-update.service systemd-update-done.service systemd-pstore.service; do
+        ln -s /dev/null "/run/systemd/system/$unit"
       done
       ip link set lo up
       ip link set lo multicast on
