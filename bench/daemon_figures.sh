@@ -33,10 +33,18 @@ echo "scenario: tests/daemon/corridor.yaml, dual return, ${duration} s of data"
 # Where these figures come from: the CPU, its cores, and the ROI scan trajroid calibrated.
 scan=$("$build/daemon/trajroid" --config "$run/trajroid.yaml" --replay "$run" --rate max 2>&1 | grep "roi scan for" || true)
 echo "machine and scan: ${scan#*roi scan for }"
-read -r p50 p99 drops wall cpu pipeline < <(figures realtime)
-echo "real-time replay: latency last packet → LCM p50 ${p50} ms, p99 ${p99} ms (goal p99 <= 2 ms); ring drops ${drops} (goal 0)"
+# Five real-time runs: the goals are the medians (one run's tail is one spell of the machine).
+runs=${TRAJROI_FIGURE_RUNS:-5}
+table=$(for _ in $(seq 1 "$runs"); do figures realtime; done)
+median() { sort -g | awk '{v[NR] = $1} END {print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
+p50=$(awk '{print $1}' <<<"$table" | median)
+p99=$(awk '{print $2}' <<<"$table" | median)
+drops=$(awk '{s += $3} END {print s}' <<<"$table")
+cpu=$(awk '{print $5}' <<<"$table" | median)
+pipeline=$(awk '{print $6}' <<<"$table" | median)
+echo "real-time replay, ${runs} runs: latency last packet → LCM p50 ${p50} ms, p99 ${p99} ms (medians; goal p99 <= 2 ms; each run's p99: $(awk '{printf "%s ", $2}' <<<"$table")); ring drops ${drops} (goal 0)"
 awk -v c="$cpu" -v p="$pipeline" -v d="$duration" 'BEGIN {
-  printf "real-time replay: CPU of the pipeline (processing + publishing threads) %.3f s for %.1f s of data = %.2f %% of one core (goal <= 5 %%)\n", p, d, 100 * p / d
+  printf "real-time replay: CPU of the pipeline (processing + publishing threads) %.3f s for %.1f s of data = %.2f %% of one core (median; goal <= 2 %%)\n", p, d, 100 * p / d
   printf "real-time replay: CPU of the whole process, the replay reader standing in for the sensors included, %.3f s = %.2f %%\n", c, 100 * c / d}'
 read -r _ _ drops wall _ _ < <(figures max)
-awk -v w="$wall" -v d="$duration" -v x="$drops" 'BEGIN {printf "as fast as possible: %.1f s of data in %.2f s = %.0fx real time (goal >= 100x); ring drops %d\n", d, w, d / w, x}'
+awk -v w="$wall" -v d="$duration" -v x="$drops" 'BEGIN {printf "as fast as possible: %.1f s of data in %.2f s = %.0fx real time (goal >= 200x); ring drops %d\n", d, w, d / w, x}'
