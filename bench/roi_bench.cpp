@@ -145,20 +145,7 @@ void calibrate(const char* shape) {
   const RoiSet set = make_set<RoiSet>(25);
   roi::GridFilter<RoiSet> grid;
   grid.build(set);
-  const roi::ScanCalibration c = grid.calibrate();
-  std::string text = roi::to_string(c.chosen);
-  if (c.forced) {
-    text += " (forced by TRAJROI_SIMD)";
-  } else {
-    text += " (ns per point:";
-    for (const roi::SimdPath path :
-         {roi::SimdPath::kAvx512, roi::SimdPath::kAvx2, roi::SimdPath::kSse2, roi::SimdPath::kScalar}) {
-      const double ns = c.ns_per_point[static_cast<int>(path)];
-      if (ns >= 0.0) text += std::string(" ") + roi::to_string(path) + " " + std::to_string(ns).substr(0, 5);
-    }
-    text += ")";
-  }
-  benchmark::AddCustomContext(std::string("scan_") + shape, text);
+  benchmark::AddCustomContext(std::string("scan_") + shape, roi::describe(grid.calibrate()));
 }
 
 int register_all() {

@@ -100,19 +100,7 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
 
 // The ROI scan this machine runs fastest, with what was measured and where.
 void log_scan_calibration(const roi::ScanCalibration& c, RoiShape shape) {
-  const char* shape_name = shape == RoiShape::kCircular ? "circles" : "rectangles";
-  if (c.forced) {
-    log::info("roi scan for {}: {} (forced by TRAJROI_SIMD) on {}", shape_name, roi::to_string(c.chosen),
-              roi::describe_machine());
-    return;
-  }
-  std::string times;
-  for (const roi::SimdPath path :
-       {roi::SimdPath::kAvx512, roi::SimdPath::kAvx2, roi::SimdPath::kSse2, roi::SimdPath::kScalar}) {
-    const double ns = c.ns_per_point[static_cast<int>(path)];
-    if (ns >= 0.0) times += fmt::format("{}{} {:.2f}", times.empty() ? "" : ", ", roi::to_string(path), ns);
-  }
-  log::info("roi scan for {}: {} ({} ns per point) on {}", shape_name, roi::to_string(c.chosen), times,
+  log::info("roi scan for {}: {} on {}", shape == RoiShape::kCircular ? "circles" : "rectangles", roi::describe(c),
             roi::describe_machine());
 }
 

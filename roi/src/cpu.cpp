@@ -2,11 +2,24 @@
 
 #include <sched.h>
 
+#include <cstdio>
 #include <fstream>
 
-#include "trajroi/roi/grid_filter.hpp"
-
 namespace trajroi::roi {
+
+std::string describe(const ScanCalibration& calibration) {
+  std::string text = to_string(calibration.chosen);
+  if (calibration.forced) return text + " (forced by TRAJROI_SIMD)";
+  std::string times;
+  for (const SimdPath path : {SimdPath::kAvx512, SimdPath::kAvx2, SimdPath::kSse2, SimdPath::kScalar}) {
+    const double ns = calibration.ns_per_point[static_cast<int>(path)];
+    if (ns < 0.0) continue;
+    char figure[32];
+    std::snprintf(figure, sizeof figure, "%.2f", ns);
+    times += (times.empty() ? "" : ", ") + std::string(to_string(path)) + " " + figure;
+  }
+  return text + " (" + times + " ns per point)";
+}
 
 std::string cpu_model() {
   std::ifstream info("/proc/cpuinfo");

@@ -88,11 +88,11 @@ ScanCalibration GridFilter<RoiSet>::calibrate() const {
   const double cx = static_cast<double>(x0_) + 0.5 * h * static_cast<double>(nx_);
   const double cy = static_cast<double>(y0_) + 0.5 * h * static_cast<double>(ny_);
   const double reach = 0.5 * h * std::hypot(static_cast<double>(nx_), static_cast<double>(ny_));
-  const ZLimits& z_limits = rois_ != nullptr ? rois_->z_limits() : ZLimits{};
-  const double z =
-      std::isfinite(z_limits.min_m) && std::isfinite(z_limits.max_m)
-          ? 0.5 * (z_limits.min_m + z_limits.max_m)
-          : (std::isfinite(z_limits.min_m) ? z_limits.min_m : (std::isfinite(z_limits.max_m) ? z_limits.max_m : 0.0));
+  // A height every point passes: between the z limits, at one that is set, or 0.
+  const ZLimits& limits = rois_->z_limits();
+  const double lo = std::isfinite(limits.min_m) ? limits.min_m : std::min(0.0, limits.max_m);
+  const double hi = std::isfinite(limits.max_m) ? limits.max_m : std::max(lo, 0.0);
+  const double z = 0.5 * (lo + hi);
   constexpr std::size_t kFirings = 1800;  // one turn
   constexpr std::size_t kLasers = 16;
   std::vector<PointXYZI> cloud;

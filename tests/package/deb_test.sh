@@ -69,11 +69,8 @@ if [ -n "$spy_classpath" ] && command -v java >/dev/null; then
   # The build's type jar swapped for the installed one.
   classpath=$(tr ':' '\n' <<<"$spy_classpath" | sed 's|.*/trajroi_lcmtypes\.jar$|/usr/share/java/trajroi_lcmtypes.jar|' | paste -sd:)
   /usr/bin/trajroi sim --quiet --scenario "$here/../daemon/corridor.yaml" --out "$work/run" >/dev/null 2>&1
-  unshare --net /bin/bash -c '
+  bash "$(dirname "$0")/../systemd/own_network.sh" /bin/bash -c '
     set -euo pipefail
-    ip link set lo up
-    ip link set lo multicast on
-    ip route add 224.0.0.0/4 dev lo src 127.0.0.1
     url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608"
     java -cp "$2" SpyDecodeCheck "$url" 12 TRAJROI_POINTS TRAJROI_POSE TRAJROI_ROI TRAJROI_STATUS >"$1/spy.txt" 2>&1 &
     check=$!

@@ -45,11 +45,8 @@ if [ "$(id -u)" -ne 0 ] || ! command -v unshare >/dev/null; then
   [ "${CI:-}" = true ] && exit 1
   exit 0
 fi
-unshare --net /bin/bash -c '
+bash "$(dirname "$0")/../systemd/own_network.sh" /bin/bash -c '
   set -euo pipefail
-  ip link set lo up
-  ip link set lo multicast on
-  ip route add 224.0.0.0/4 dev lo src 127.0.0.1
   url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608"
   "$1/subscriber/subscriber" "$url" >"$1/cpp.txt" 2>&1 &
   cpp=$!

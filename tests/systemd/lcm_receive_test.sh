@@ -24,11 +24,8 @@ trap 'sysctl -q -w net.core.rmem_max="$old_max" net.core.rmem_default="$old_defa
 # One real-time replay with lcm-logger listening; prints "published RECEIVED".
 run() {
   local label=$1
-  unshare --net /bin/bash -c '
+  bash "$(dirname "$0")/../systemd/own_network.sh" /bin/bash -c '
     set -euo pipefail
-    ip link set lo up
-    ip link set lo multicast on
-    ip route add 224.0.0.0/4 dev lo src 127.0.0.1
     lcm-logger --quiet "$1/$2.lcmlog" >"$1/$2.logger.txt" 2>&1 &
     logger=$!
     sleep 1

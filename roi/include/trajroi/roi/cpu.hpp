@@ -4,7 +4,13 @@
 // scan calibration line): the CPU's model name and the cores this process may use.
 #include <string>
 
+#include "trajroi/roi/grid_filter.hpp"
+
 namespace trajroi::roi {
+
+// "avx512 (avx512 1.55, avx2 1.65, sse2 2.64, scalar 6.04 ns per point)" or
+// "sse2 (forced by TRAJROI_SIMD)": what a calibration chose and measured.
+[[nodiscard]] std::string describe(const ScanCalibration& calibration);
 
 // /proc/cpuinfo's "model name" (x86) or "Model"/"CPU part" line; "unknown CPU" without one.
 [[nodiscard]] std::string cpu_model();
