@@ -1,6 +1,8 @@
 #include "trajroi/daemon/messages.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "trajroi/pose/attitude.hpp"
@@ -20,6 +22,40 @@ void set_pose(const PublishedPose& p, double (&position)[3], double (&orientatio
   orientation[1] = p.orientation.x();
   orientation[2] = p.orientation.y();
   orientation[3] = p.orientation.z();
+}
+
+void store_be32(std::uint8_t* p, std::uint32_t v) noexcept {
+  v = __builtin_bswap32(v);
+  std::memcpy(p, &v, sizeof v);
+}
+
+// LCM's big-endian 32-bit elements (float bits as they are), in a loop the compiler vectorizes.
+template <typename T>
+std::uint8_t* store_be32_array(std::uint8_t* out, const std::vector<T>& values) noexcept {
+  static_assert(sizeof(T) == sizeof(std::uint32_t));
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    std::uint32_t v;
+    std::memcpy(&v, &values[i], sizeof v);
+    store_be32(out + 4 * i, v);
+  }
+  return out + 4 * values.size();
+}
+
+// Every field of points_t but the points.
+void fill_points_head(const Sweep& sweep, PoseMode mode, trajroi::points_t& out) {
+  out.sweep_index = static_cast<std::int64_t>(sweep.index);
+  out.sweep_start_ns = sweep.start_ns;
+  out.sweep_end_ns = sweep.end_ns;
+  out.sweep_start_utc_ns = sweep.start_utc_ns;
+  out.time_source = std::string(sweep.time_source);
+  out.trajectory_id = sweep.trajectory_id;
+  out.pose_mode = mode == PoseMode::kPerSweep ? trajroi::points_t::POSE_PER_SWEEP : trajroi::points_t::POSE_PER_FIRING;
+  out.return_mode = static_cast<std::int8_t>(sweep.return_mode);
+  out.partial = sweep.partial;
+  out.points_in = static_cast<std::int32_t>(sweep.points_in);
+  out.lost_packets = static_cast<std::int32_t>(sweep.lost_packets);
+  fill_pose(sweep, out.pose);
+  set_pose(sweep.sensor, out.sensor_position_m, out.sensor_orientation);
 }
 
 }  // namespace
@@ -42,19 +78,7 @@ void fill_pose(const Sweep& sweep, trajroi::pose_t& out) {
 }
 
 void fill_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& out) {
-  out.sweep_index = static_cast<std::int64_t>(sweep.index);
-  out.sweep_start_ns = sweep.start_ns;
-  out.sweep_end_ns = sweep.end_ns;
-  out.sweep_start_utc_ns = sweep.start_utc_ns;
-  out.time_source = std::string(sweep.time_source);
-  out.trajectory_id = sweep.trajectory_id;
-  out.pose_mode = mode == PoseMode::kPerSweep ? trajroi::points_t::POSE_PER_SWEEP : trajroi::points_t::POSE_PER_FIRING;
-  out.return_mode = static_cast<std::int8_t>(sweep.return_mode);
-  out.partial = sweep.partial;
-  out.points_in = static_cast<std::int32_t>(sweep.points_in);
-  out.lost_packets = static_cast<std::int32_t>(sweep.lost_packets);
-  fill_pose(sweep, out.pose);
-  set_pose(sweep.sensor, out.sensor_position_m, out.sensor_orientation);
+  fill_points_head(sweep, mode, out);
   out.num_points = static_cast<std::int32_t>(sweep.size());
   copy_into(out.x, sweep.x);
   copy_into(out.y, sweep.y);
@@ -63,6 +87,32 @@ void fill_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& out) {
   copy_into(out.ring, sweep.ring);
   copy_into(out.return_type, sweep.return_type);
   copy_into(out.time_offset_ns, sweep.time_offset_ns);
+}
+
+void encode_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& head, std::vector<std::uint8_t>& out) {
+  fill_points_head(sweep, mode, head);
+  head.num_points = 0;  // the arrays empty: num_points is the head's last field, patched below
+  head.x.clear();
+  head.y.clear();
+  head.z.clear();
+  head.intensity.clear();
+  head.ring.clear();
+  head.return_type.clear();
+  head.time_offset_ns.clear();
+  const auto head_size = static_cast<std::size_t>(head.getEncodedSize());
+  const std::size_t n = sweep.size();
+  out.resize(head_size + n * (4 * sizeof(std::uint32_t) + 3));
+  std::uint8_t* p = out.data();
+  (void)head.encode(p, 0, static_cast<int>(head_size));
+  store_be32(p + head_size - 4, static_cast<std::uint32_t>(n));
+  p += head_size;
+  p = store_be32_array(p, sweep.x);
+  p = store_be32_array(p, sweep.y);
+  p = store_be32_array(p, sweep.z);
+  p = std::copy(sweep.intensity.begin(), sweep.intensity.end(), p);
+  p = std::copy(sweep.ring.begin(), sweep.ring.end(), p);
+  p = std::copy(sweep.return_type.begin(), sweep.return_type.end(), p);
+  (void)store_be32_array(p, sweep.time_offset_ns);
 }
 
 void fill_roi(const Sweep& sweep, trajroi::roi_t& out) {

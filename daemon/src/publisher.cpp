@@ -121,8 +121,8 @@ void Publisher::publish_sweep(const Sweep& s) {
   if (s.filtered) {
     fill_roi(s, roi_);
     send(config_.lcm.roi, roi_);
-    fill_points(s, config_.pose_mode, points_);
-    send(config_.lcm.points, points_);
+    encode_points(s, config_.pose_mode, points_, points_encoded_);
+    outlet_.publish(config_.lcm.points, points_encoded_);
     // A partial sweep's latency (the stream's end, flushed at a stop) is the wait for the stop,
     // not the pipeline's: left out of the figures.
     if (!s.partial) {

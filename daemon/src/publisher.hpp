@@ -49,6 +49,7 @@ class Publisher {
   const DaemonConfig& config_;
   pose::GlobalFrame frame_;
   std::vector<std::uint8_t> encoded_;
+  std::vector<std::uint8_t> points_encoded_;
   trajroi::points_t points_;
   trajroi::pose_t pose_;
   trajroi::roi_t roi_;

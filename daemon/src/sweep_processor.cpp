@@ -307,48 +307,44 @@ void SweepProcessor::add_points(const vlp16::Frame& frame, std::size_t first, Sw
   if (first == 0 || !in_sweep_) start_sweep(frame);
   sweep_.last_packet_arrival_ns = arrival_ns_;
   const std::size_t end = frame.points.size();
-  if (!sweep_.filtered) return;
-  if (config_.pose_mode == PoseMode::kPerSweep) {
-    for (std::size_t i = first; i < end; i += kScratchPoints) {
-      filter_run(frame, i, std::min(end, i + kScratchPoints), sweep_sensor_pose_, sink);
-    }
-    return;
-  }
-  // Per firing: consecutive points of one firing period share a pose.
-  std::size_t i = first;
-  while (i < end) {
-    pose::PoseStatus status{};
-    const Eigen::Isometry3d* pose = firing_.at(frame.start_time_ns + frame.points[i].time_offset_ns, status);
-    if (pose == nullptr) {
+  for (std::size_t i = first; i < end && sweep_.filtered; i += kScratchPoints) {
+    const pose::PoseStatus status = filter_batch(frame, i, std::min(end, i + kScratchPoints), sink);
+    if (status != pose::PoseStatus::kValid) {
       sweep_.filtered = false;
       sweep_.pose_status = status;
       sweep_.pose_measured = firing_.measured();
       sweep_.pose_limit = firing_.limit();
       sweep_.clear_points();
       have_hint_ = false;
-      return;
     }
-    const Eigen::Isometry3d global_from_lidar = *pose;
-    const std::uint64_t generation = firing_.generation();
-    std::size_t j = i + 1;
-    while (j < end && j - i < kScratchPoints) {
-      (void)firing_.at(frame.start_time_ns + frame.points[j].time_offset_ns, status);
-      if (firing_.generation() != generation) break;
-      ++j;
-    }
-    filter_run(frame, i, j, global_from_lidar, sink);
-    i = j;
   }
 }
 
-void SweepProcessor::filter_run(const vlp16::Frame& frame, std::size_t first, std::size_t end,
-                                const Eigen::Isometry3d& global_from_lidar, SweepSink& sink) {
+pose::PoseStatus SweepProcessor::filter_batch(const vlp16::Frame& frame, std::size_t first, std::size_t end,
+                                              SweepSink& sink) {
   scratch_.resize(end - first);
-  for (std::size_t i = first; i < end; ++i) {
-    const vlp16::Point& p = frame.points[i];
-    scratch_[i - first] = roi::PointXYZI{p.x, p.y, p.z, static_cast<float>(p.intensity)};
+  const auto place = [&](std::size_t from, std::size_t to, const Eigen::Isometry3d& global_from_lidar) {
+    for (std::size_t i = from; i < to; ++i) {
+      const vlp16::Point& p = frame.points[i];
+      const auto [x, y, z] = roi::transform_point<float>(global_from_lidar, p.x, p.y, p.z);
+      scratch_[i - first] = roi::PointXYZI{x, y, z, static_cast<float>(p.intensity)};
+    }
+  };
+  if (config_.pose_mode == PoseMode::kPerSweep) {
+    place(first, end, sweep_sensor_pose_);
+  } else {
+    // Per firing: the points of one firing period (in time order) share a pose.
+    for (std::size_t i = first; i < end;) {
+      pose::PoseStatus status{};
+      const Eigen::Isometry3d* pose = firing_.at(frame.start_time_ns + frame.points[i].time_offset_ns, status);
+      if (pose == nullptr) return status;
+      std::size_t j = i + 1;
+      while (j < end && firing_.covers(frame.start_time_ns + frame.points[j].time_offset_ns))
+        ++j;
+      place(i, j, *pose);
+      i = j;
+    }
   }
-  roi::transform_points(global_from_lidar, scratch_, scratch_);
   const std::span<const roi::PointXYZI> placed(scratch_);
   sink.on_placed(frame, first, placed);
   if (config_.roi.shape == RoiShape::kCircular) {
@@ -361,21 +357,38 @@ void SweepProcessor::filter_run(const vlp16::Frame& frame, std::size_t first, st
       config_.buffers.max_points_per_sweep - std::min(config_.buffers.max_points_per_sweep, s.size());
   const std::size_t n = std::min(room, kept_.size());
   s.truncated += static_cast<std::uint32_t>(kept_.size() - n);
+  // Grown once, then written through pointers (push_back would store each array's end at
+  // every point: the compiler cannot tell the arrays apart).
+  const std::size_t at = s.size();
+  const auto grown = [at, n](auto& v) {
+    v.resize(at + n);
+    return v.data() + at;
+  };
+  float* const x = grown(s.x);
+  float* const y = grown(s.y);
+  float* const z = grown(s.z);
+  std::uint8_t* const intensity = grown(s.intensity);
+  std::uint8_t* const ring = grown(s.ring);
+  std::uint8_t* const return_type = grown(s.return_type);
+  std::int32_t* const time_offset_ns = grown(s.time_offset_ns);
+  const std::uint32_t* const kept = kept_.data();
   for (std::size_t k = 0; k < n; ++k) {
-    const roi::PointXYZI& g = scratch_[kept_[k]];
-    const vlp16::Point& p = frame.points[first + kept_[k]];
-    s.x.push_back(g.x);
-    s.y.push_back(g.y);
-    s.z.push_back(g.z);
-    s.intensity.push_back(p.intensity);
-    s.ring.push_back(p.ring);
-    s.return_type.push_back(static_cast<std::uint8_t>(p.return_type));
-    s.time_offset_ns.push_back(static_cast<std::int32_t>(p.time_offset_ns));
+    const roi::PointXYZI& g = scratch_[kept[k]];
+    const vlp16::Point& p = frame.points[first + kept[k]];
+    x[k] = g.x;
+    y[k] = g.y;
+    z[k] = g.z;
+    intensity[k] = p.intensity;
+    ring[k] = p.ring;
+    return_type[k] = static_cast<std::uint8_t>(p.return_type);
+    time_offset_ns[k] = static_cast<std::int32_t>(p.time_offset_ns);
   }
   if (keep_indices_) {
+    std::uint32_t* const index = grown(s.point_index);
     for (std::size_t k = 0; k < n; ++k)
-      s.point_index.push_back(static_cast<std::uint32_t>(first + kept_[k]));
+      index[k] = static_cast<std::uint32_t>(first + kept[k]);
   }
+  return pose::PoseStatus::kValid;
 }
 
 void SweepProcessor::end_sweep(const vlp16::Frame& frame, SweepSink& sink) {

@@ -35,15 +35,11 @@ template <typename Point>
 void transform_impl(const Eigen::Isometry3d& target_from_source, std::span<const Point> in, std::span<Point> out) {
   assert(in.size() == out.size());
   using Scalar = decltype(Point{}.x);
-  const Eigen::Matrix3d& r = target_from_source.linear();
-  const Eigen::Vector3d& t = target_from_source.translation();
   for (std::size_t i = 0; i < in.size(); ++i) {
-    const auto x = static_cast<double>(in[i].x);
-    const auto y = static_cast<double>(in[i].y);
-    const auto z = static_cast<double>(in[i].z);
-    out[i].x = static_cast<Scalar>(r(0, 0) * x + r(0, 1) * y + r(0, 2) * z + t.x());
-    out[i].y = static_cast<Scalar>(r(1, 0) * x + r(1, 1) * y + r(1, 2) * z + t.y());
-    out[i].z = static_cast<Scalar>(r(2, 0) * x + r(2, 1) * y + r(2, 2) * z + t.z());
+    const auto [x, y, z] = transform_point<Scalar>(target_from_source, in[i].x, in[i].y, in[i].z);
+    out[i].x = x;
+    out[i].y = y;
+    out[i].z = z;
     if constexpr (requires { in[i].intensity; }) out[i].intensity = in[i].intensity;
   }
 }

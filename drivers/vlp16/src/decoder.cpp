@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+#include <memory>
 #include <numbers>
 
 namespace trajroi::vlp16 {
@@ -65,7 +69,36 @@ std::array<std::uint8_t, kLasers> Calibration::rings() const {
   return ring;
 }
 
-PacketDecoder::PacketDecoder(const Calibration& calibration, DecodeOptions options) : options_(options) {
+// cos and sin computed once per process: of every azimuth the sensor reports (centidegrees),
+// and of the in-block rotation of every channel for every gap the series covers. Each entry is
+// the value decode() would otherwise compute for that block, so decoding is unchanged.
+struct PacketDecoder::AngleTables {
+  std::array<CosSin, kAzimuthLimit> azimuth;
+  std::array<std::array<double, kChannels>, kSeriesGapLimit_cdeg + 1> step_cos, step_sin;
+};
+
+const PacketDecoder::AngleTables& PacketDecoder::angle_tables() {
+  static const std::unique_ptr<const AngleTables> tables = [] {
+    auto t = std::make_unique<AngleTables>();
+    for (std::uint32_t a = 0; a < kAzimuthLimit; ++a) {
+      const double rad = static_cast<double>(a) * kCentidegToRad;
+      t->azimuth[a] = {std::cos(rad), std::sin(rad)};
+    }
+    for (std::uint32_t gap = 0; gap <= kSeriesGapLimit_cdeg; ++gap) {
+      const double gap_rad = static_cast<double>(gap) * kCentidegToRad;
+      for (std::size_t channel = 0; channel < kChannels; ++channel) {
+        const CosSin s = small_angle(gap_rad * azimuth_fraction(channel));
+        t->step_cos[gap][channel] = s.c;
+        t->step_sin[gap][channel] = s.s;
+      }
+    }
+    return std::unique_ptr<const AngleTables>(std::move(t));
+  }();
+  return *tables;
+}
+
+PacketDecoder::PacketDecoder(const Calibration& calibration, DecodeOptions options)
+    : options_(options), tables_(angle_tables()) {
   const auto rings = calibration.rings();
   for (std::size_t i = 0; i < kLasers; ++i) {
     const LaserCalibration& cal = calibration.lasers[i];
@@ -76,6 +109,8 @@ PacketDecoder::PacketDecoder(const Calibration& calibration, DecodeOptions optio
                        cal.vert_offset_m,
                        cal.horiz_offset_m,
                        cal.dist_correction_m,
+                       cal.vert_offset_m * std::sin(cal.vert_angle_rad),
+                       cal.vert_offset_m * std::cos(cal.vert_angle_rad),
                        rings[i]};
     rotation_corrected_ = rotation_corrected_ || cal.rot_correction_rad != 0.0;
   }
@@ -90,6 +125,60 @@ PacketDecoder::PacketDecoder(const Calibration& calibration, DecodeOptions optio
   }
 }
 
+void PacketDecoder::directions(std::uint16_t azimuth, std::uint32_t gap, Directions& d) const noexcept {
+  if (gap <= kSeriesGapLimit_cdeg && azimuth < kAzimuthLimit) {
+    const CosSin base = tables_.azimuth[azimuth];
+    const auto& step_cos = tables_.step_cos[gap];
+    const auto& step_sin = tables_.step_sin[gap];
+    for (std::size_t channel = 0; channel < kChannels; ++channel) {
+      d.cos_a[channel] = base.c * step_cos[channel] - base.s * step_sin[channel];
+      d.sin_a[channel] = base.s * step_cos[channel] + base.c * step_sin[channel];
+    }
+  } else {
+    const double base_rad = static_cast<double>(azimuth) * kCentidegToRad;
+    const double gap_rad = static_cast<double>(gap) * kCentidegToRad;
+    for (std::size_t channel = 0; channel < kChannels; ++channel) {
+      const double a = base_rad + gap_rad * azimuth_fraction_[channel];
+      d.cos_a[channel] = std::cos(a);
+      d.sin_a[channel] = std::sin(a);
+    }
+  }
+  // The azimuth each channel reports: interpolated, wrapped at 360°, in degrees; 359.99999…
+  // rounds up to 360 in float and is reported as 0.
+  const auto base_cdeg = static_cast<double>(azimuth);
+  const auto gap_cdeg = static_cast<double>(gap);
+  constexpr auto kLimit = static_cast<double>(kAzimuthLimit);
+#if defined(__SSE2__)
+  // The same operations two channels at a time (the compiler keeps the selections as branches).
+  const __m128d base = _mm_set1_pd(base_cdeg);
+  const __m128d step = _mm_set1_pd(gap_cdeg);
+  const __m128d limit = _mm_set1_pd(kLimit);
+  const __m128d hundred = _mm_set1_pd(100.0);
+  const __m128 full_turn = _mm_set1_ps(360.0f);
+  for (std::size_t channel = 0; channel < kChannels; channel += 2) {
+    __m128d a = _mm_add_pd(base, _mm_mul_pd(step, _mm_loadu_pd(&azimuth_fraction_[channel])));
+    a = _mm_sub_pd(a, _mm_and_pd(_mm_cmpge_pd(a, limit), limit));
+    const __m128 deg = _mm_cvtpd_ps(_mm_div_pd(a, hundred));
+    _mm_storel_pi(reinterpret_cast<__m64*>(&d.azimuth_deg[channel]), _mm_and_ps(deg, _mm_cmplt_ps(deg, full_turn)));
+  }
+#else
+  for (std::size_t channel = 0; channel < kChannels; ++channel) {
+    double azimuth_cdeg = base_cdeg + gap_cdeg * azimuth_fraction_[channel];
+    if (azimuth_cdeg >= kLimit) azimuth_cdeg -= kLimit;
+    const auto azimuth_deg = static_cast<float>(azimuth_cdeg / 100.0);
+    d.azimuth_deg[channel] = azimuth_deg < 360.0f ? azimuth_deg : 0.0f;
+  }
+#endif
+  if (rotation_corrected_) {  // θ = azimuth − rot_correction
+    for (std::size_t channel = 0; channel < kChannels; ++channel) {
+      const Laser& laser = lasers_[channel % kLasers];
+      const double c = d.cos_a[channel] * laser.cos_rot + d.sin_a[channel] * laser.sin_rot;
+      d.sin_a[channel] = d.sin_a[channel] * laser.cos_rot - d.cos_a[channel] * laser.sin_rot;
+      d.cos_a[channel] = c;
+    }
+  }
+}
+
 PacketDecoder::Result PacketDecoder::decode(std::span<const std::uint8_t> packet, std::vector<Point>& out) const {
   Result result;
   const std::uint8_t mode = return_mode_byte(packet);
@@ -98,6 +187,10 @@ PacketDecoder::Result PacketDecoder::decode(std::span<const std::uint8_t> packet
   const ReturnType single_type =
       mode == static_cast<std::uint8_t>(ReturnMode::kLast) ? ReturnType::kLast : ReturnType::kStrongest;
   if (out.capacity() - out.size() < kBlocks * kChannels) out.reserve(out.size() + kBlocks * kChannels * 64);
+  const double min_range = options_.min_range_m;
+  const double max_range = options_.max_range_m;
+  Directions d;
+  const std::size_t points_before = out.size();
 
   for (std::size_t block = 0; block < kBlocks; block += step) {
     const std::uint16_t azimuth = block_azimuth(packet, block);
@@ -105,11 +198,7 @@ PacketDecoder::Result PacketDecoder::decode(std::span<const std::uint8_t> packet
     // the packet's last firing, the advance over the previous one.
     const std::uint32_t gap = block + step < kBlocks ? azimuth_gap(azimuth, block_azimuth(packet, block + step))
                                                      : azimuth_gap(block_azimuth(packet, block - step), azimuth);
-    const double base_rad = static_cast<double>(azimuth) * kCentidegToRad;
-    const double cos_base = std::cos(base_rad);
-    const double sin_base = std::sin(base_rad);
-    const double gap_rad = static_cast<double>(gap) * kCentidegToRad;
-    const bool series = gap <= kSeriesGapLimit_cdeg;
+    directions(azimuth, gap, d);
     const auto& time_ns = time_ns_[block / step];
 
     for (std::size_t channel = 0; channel < kChannels; ++channel) {
@@ -137,54 +226,29 @@ PacketDecoder::Result PacketDecoder::decode(std::span<const std::uint8_t> packet
         if (second_raw == 0) continue;
       }
 
-      const double fraction = azimuth_fraction_[channel];
-      double cos_a, sin_a;
-      if (series) {
-        const CosSin d = small_angle(gap_rad * fraction);
-        cos_a = cos_base * d.c - sin_base * d.s;
-        sin_a = sin_base * d.c + cos_base * d.s;
-      } else {
-        const double a = base_rad + gap_rad * fraction;
-        cos_a = std::cos(a);
-        sin_a = std::sin(a);
-      }
-      double azimuth_cdeg = static_cast<double>(azimuth) + static_cast<double>(gap) * fraction;
-      if (azimuth_cdeg >= kAzimuthLimit) azimuth_cdeg -= kAzimuthLimit;
-      float azimuth_deg = static_cast<float>(azimuth_cdeg / 100.0);
-      if (azimuth_deg >= 360.0f) azimuth_deg = 0.0f;  // 359.99999… rounds up in float
-
       const std::size_t laser_index = channel % kLasers;
       const Laser& laser = lasers_[laser_index];
-      if (rotation_corrected_) {  // θ = azimuth − rot_correction
-        const double c = cos_a * laser.cos_rot + sin_a * laser.sin_rot;
-        sin_a = sin_a * laser.cos_rot - cos_a * laser.sin_rot;
-        cos_a = c;
-      }
-
-      auto emit = [&](std::uint16_t raw, std::size_t from_block, ReturnType type) {
+      const double cos_a = d.cos_a[channel];
+      const double sin_a = d.sin_a[channel];
+      const auto emit = [&](std::uint16_t raw, std::size_t from_block, ReturnType type) {
         const double range = static_cast<double>(raw) * kDistanceUnit_m + laser.dist_correction_m;
-        if (!(range >= options_.min_range_m && range <= options_.max_range_m)) {
+        if (!(range >= min_range && range <= max_range)) {
           ++result.out_of_range;
           return;
         }
-        const double r_xy = range * laser.cos_vert - laser.vert_offset_m * laser.sin_vert;
-        Point& p = out.emplace_back();
-        p.x = static_cast<float>(r_xy * cos_a + laser.horiz_offset_m * sin_a);
-        p.y = static_cast<float>(-r_xy * sin_a + laser.horiz_offset_m * cos_a);
-        p.z = static_cast<float>(range * laser.sin_vert + laser.vert_offset_m * laser.cos_vert);
-        p.distance_m = static_cast<float>(range);
-        p.azimuth_deg = azimuth_deg;
-        p.time_offset_ns = time_ns[channel];
-        p.intensity = channel_reflectivity(packet, from_block, channel);
-        p.laser = static_cast<std::uint8_t>(laser_index);
-        p.ring = laser.ring;
-        p.return_type = type;
-        ++result.points;
+        const double r_xy = range * laser.cos_vert - laser.offset_sin_vert;
+        out.push_back(Point{static_cast<float>(r_xy * cos_a + laser.horiz_offset_m * sin_a),
+                            static_cast<float>(-r_xy * sin_a + laser.horiz_offset_m * cos_a),
+                            static_cast<float>(range * laser.sin_vert + laser.offset_cos_vert),
+                            static_cast<float>(range), d.azimuth_deg[channel], time_ns[channel],
+                            channel_reflectivity(packet, from_block, channel), static_cast<std::uint8_t>(laser_index),
+                            laser.ring, type});
       };
       if (first_raw != 0) emit(first_raw, block, first_type);
       if (second_raw != 0) emit(second_raw, block + 1, ReturnType::kStrongest);
     }
   }
+  result.points = out.size() - points_before;
   return result;
 }
 

@@ -181,21 +181,39 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   product_id_ = vlp16::product_id(packet);
   return_mode_ = mode;
 
+  // Each point goes to the frame, which ends where the azimuth passes the cut. The frame's
+  // array is grown for the whole packet up front and the loop's state kept in locals (written
+  // back around the rare end of a frame), so that nothing but the point is stored per point.
+  const std::size_t n = scratch_.size();
+  std::vector<Point>& points = frame_.points;
+  std::size_t used = points.size();
+  points.resize(used + n);
+  std::int64_t end_time_ns = frame_.end_time_ns;
+  double last_phase_deg = last_phase_deg_;
+  bool have_phase = have_phase_;
+  const auto finish = [&](std::size_t i, bool partial) {
+    points.resize(used);
+    frame_.end_time_ns = end_time_ns;
+    finish_frame(sink, partial);
+    used = 0;
+    points.resize(n - i);
+  };
   bool counted = false;
-  for (const Point& point : scratch_) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point& point = scratch_[i];
     double phase = static_cast<double>(point.azimuth_deg) - options_.cut_azimuth_deg;
     if (phase < 0.0) phase += 360.0;
     const std::int64_t t = time_ns + point.time_offset_ns;
-    if (have_phase_ && phase < last_phase_deg_ - 180.0) {
-      finish_frame(sink, false);
-    } else if (!frame_.points.empty() && t - frame_.start_time_ns > kMaxFrameDuration_ns) {
-      finish_frame(sink, true);
+    if (have_phase && phase < last_phase_deg - 180.0) {
+      finish(i, false);
+    } else if (used > 0 && t - frame_.start_time_ns > kMaxFrameDuration_ns) {
+      finish(i, true);
     }
-    last_phase_deg_ = phase;
-    have_phase_ = true;
-    if (frame_.points.empty()) {
+    last_phase_deg = phase;
+    have_phase = true;
+    if (used == 0) {
       frame_.start_time_ns = t;
-      frame_.end_time_ns = t;
+      end_time_ns = t;
       frame_.start_utc_ns = utc_ns ? std::optional(*utc_ns + point.time_offset_ns) : std::nullopt;
       frame_.return_mode = mode;
     }
@@ -203,10 +221,14 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
       ++frame_.packets;
       counted = true;
     }
-    Point& placed = frame_.points.emplace_back(point);
+    Point& placed = points[used++];
+    placed = point;
     placed.time_offset_ns = static_cast<std::uint32_t>(t - frame_.start_time_ns);
-    frame_.end_time_ns = std::max(frame_.end_time_ns, t);
+    end_time_ns = std::max(end_time_ns, t);
   }
+  frame_.end_time_ns = end_time_ns;
+  last_phase_deg_ = last_phase_deg;
+  have_phase_ = have_phase;
   if (!counted) ++frame_.packets;
   report_points(sink);
 }

@@ -77,8 +77,12 @@ void PoseBuffer::Ring<T>::push(const T& item) noexcept {
 template <class T>
 std::size_t PoseBuffer::Ring<T>::floor(std::int64_t t_ns) const noexcept {
   if (size == 0 || t_ns < at(0).t_ns) return size;
-  std::size_t lo = 0;
-  std::size_t hi = size - 1;  // invariant: at(lo).t_ns ≤ t
+  constexpr std::size_t kNewestLooked = 8;
+  std::size_t hi = size - 1;
+  for (std::size_t n = 0; n < kNewestLooked && hi > 0; ++n, --hi) {
+    if (at(hi).t_ns <= t_ns) return hi;
+  }
+  std::size_t lo = 0;  // invariant: at(lo).t_ns ≤ t
   while (lo < hi) {
     const std::size_t mid = lo + (hi - lo + 1) / 2;
     if (at(mid).t_ns <= t_ns) {

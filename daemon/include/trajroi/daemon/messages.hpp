@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "trajroi/daemon/config.hpp"
 #include "trajroi/daemon/sweep_processor.hpp"
@@ -20,6 +21,11 @@ namespace trajroi::daemon {
 
 void fill_pose(const Sweep& sweep, trajroi::pose_t& out);
 void fill_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& out);
+// The sweep's points_t encoded (LCM's fingerprint and big-endian fields, the bytes
+// points_t::encode writes for fill_points' message) into `out`, resized to the size. The
+// arrays go from the sweep's vectors straight into the bytes: LCM's generated encoder swaps
+// them an element at a time. `head` is scratch for the fields before the arrays.
+void encode_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& head, std::vector<std::uint8_t>& out);
 void fill_roi(const Sweep& sweep, trajroi::roi_t& out);
 
 // Why an incoming trajectory was refused (counted by reason in status_t).

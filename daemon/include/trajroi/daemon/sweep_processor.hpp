@@ -197,8 +197,10 @@ class SweepProcessor {
   void start_sweep(const vlp16::Frame& frame);
   void add_points(const vlp16::Frame& frame, std::size_t first, SweepSink& sink);
   void end_sweep(const vlp16::Frame& frame, SweepSink& sink);
-  void filter_run(const vlp16::Frame& frame, std::size_t first, std::size_t end,
-                  const Eigen::Isometry3d& global_from_lidar, SweepSink& sink);
+  // Places points [first, end) of the frame in the global frame (one pose per firing, or the
+  // sweep's), filters them in one scan and appends the kept ones. Answers kValid, or the
+  // status of a firing whose pose was not valid (the sweep is then withheld).
+  pose::PoseStatus filter_batch(const vlp16::Frame& frame, std::size_t first, std::size_t end, SweepSink& sink);
 
   DaemonConfig config_;
   vlp16::StreamDecoder decoder_;

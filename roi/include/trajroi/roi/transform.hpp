@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <array>
 #include <span>
 
 #include "trajroi/roi/point.hpp"
@@ -31,5 +32,20 @@ void transform_points(const Eigen::Isometry3d& target_from_source, std::span<con
                       std::span<PointXYZI> out);
 void transform_points(const Eigen::Isometry3d& target_from_source, std::span<const PointXYZd> in,
                       std::span<PointXYZd> out);
+
+// One point as transform_points computes it (in double, each coordinate rounded once), for
+// callers whose points come in another layout.
+template <typename Scalar, typename In>
+[[nodiscard]] inline std::array<Scalar, 3> transform_point(const Eigen::Isometry3d& target_from_source, In x_in,
+                                                           In y_in, In z_in) noexcept {
+  const Eigen::Matrix3d& r = target_from_source.linear();
+  const Eigen::Vector3d& t = target_from_source.translation();
+  const auto x = static_cast<double>(x_in);
+  const auto y = static_cast<double>(y_in);
+  const auto z = static_cast<double>(z_in);
+  return {static_cast<Scalar>(r(0, 0) * x + r(0, 1) * y + r(0, 2) * z + t.x()),
+          static_cast<Scalar>(r(1, 0) * x + r(1, 1) * y + r(1, 2) * z + t.y()),
+          static_cast<Scalar>(r(2, 0) * x + r(2, 1) * y + r(2, 2) * z + t.z())};
+}
 
 }  // namespace trajroi::roi

@@ -93,9 +93,21 @@ class PacketDecoder {
     double cos_vert, sin_vert;
     double cos_rot, sin_rot;
     double vert_offset_m, horiz_offset_m, dist_correction_m;
+    double offset_sin_vert, offset_cos_vert;  // vert_offset_m · sin_vert, · cos_vert
     std::uint8_t ring;
   };
+  // Per channel of one firing (pair): cos θ, sin θ of its direction and the azimuth it reports.
+  struct Directions {
+    std::array<double, kFiringsPerBlock * kLasers> cos_a, sin_a;
+    std::array<float, kFiringsPerBlock * kLasers> azimuth_deg;
+  };
+  // The directions of the channels of a block at `azimuth`, advancing by `gap` over it, in
+  // loops without branches (the compiler vectorizes them).
+  void directions(std::uint16_t azimuth, std::uint32_t gap, Directions& d) const noexcept;
+  struct AngleTables;
+  [[nodiscard]] static const AngleTables& angle_tables();  // built at the first call, then shared
   DecodeOptions options_;
+  const AngleTables& tables_;
   std::array<Laser, kLasers> lasers_{};
   bool rotation_corrected_ = false;  // some rot_correction ≠ 0
   // Per channel 0 … 31 of a block: its firing time after the block's first, as a fraction of

@@ -112,10 +112,15 @@ class PoseBuffer {
     std::vector<T> items;
     std::size_t head = 0;  // index of the oldest
     std::size_t size = 0;
-    [[nodiscard]] const T& at(std::size_t i) const noexcept { return items[(head + i) % items.size()]; }
+    [[nodiscard]] const T& at(std::size_t i) const noexcept {
+      const std::size_t k = head + i;  // head, i < items.size(): one wrap at most, no division
+      return items[k < items.size() ? k : k - items.size()];
+    }
     [[nodiscard]] const T& newest() const noexcept { return at(size - 1); }
     void push(const T& item) noexcept;
-    // Index of the last sample with time ≤ t, or size when t precedes every sample.
+    // Index of the last sample with time ≤ t, or size when t precedes every sample. Queries
+    // come near the newest samples (a sweep's firings, as the samples arrive): those are
+    // looked at first, then the rest is bisected.
     [[nodiscard]] std::size_t floor(std::int64_t t_ns) const noexcept;
   };
 
@@ -157,6 +162,10 @@ class FiringPoses {
     }
     status = status_;
     return status_ == PoseStatus::kValid ? &global_from_sensor_ : nullptr;
+  }
+  // Whether at(t) would answer the last query's pose without a new one.
+  [[nodiscard]] bool covers(std::int64_t t_ns) const noexcept {
+    return have_ && t_ns >= query_ns_ && t_ns - query_ns_ < period_ns_;
   }
   [[nodiscard]] std::uint64_t generation() const noexcept { return generation_; }
   // The last query's failing figure and its limit (PoseQuery::measured, limit).
