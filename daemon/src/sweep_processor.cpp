@@ -323,12 +323,13 @@ void SweepProcessor::add_points(const vlp16::Frame& frame, std::size_t first, Sw
 pose::PoseStatus SweepProcessor::filter_batch(const vlp16::Frame& frame, std::size_t first, std::size_t end,
                                               SweepSink& sink) {
   scratch_.resize(end - first);
+  for (std::size_t i = first; i < end; ++i) {
+    const vlp16::Point& p = frame.points[i];
+    scratch_[i - first] = roi::PointXYZI{p.x, p.y, p.z, static_cast<float>(p.intensity)};
+  }
   const auto place = [&](std::size_t from, std::size_t to, const Eigen::Isometry3d& global_from_lidar) {
-    for (std::size_t i = from; i < to; ++i) {
-      const vlp16::Point& p = frame.points[i];
-      const auto [x, y, z] = roi::transform_point<float>(global_from_lidar, p.x, p.y, p.z);
-      scratch_[i - first] = roi::PointXYZI{x, y, z, static_cast<float>(p.intensity)};
-    }
+    const std::span<roi::PointXYZI> run = std::span(scratch_).subspan(from - first, to - from);
+    roi::transform_points(global_from_lidar, run, run);
   };
   if (config_.pose_mode == PoseMode::kPerSweep) {
     place(first, end, sweep_sensor_pose_);

@@ -1,6 +1,9 @@
 #include "trajroi/roi/transform.hpp"
 
 #include <cassert>
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
 
 namespace trajroi::roi {
 
@@ -35,19 +38,63 @@ template <typename Point>
 void transform_impl(const Eigen::Isometry3d& target_from_source, std::span<const Point> in, std::span<Point> out) {
   assert(in.size() == out.size());
   using Scalar = decltype(Point{}.x);
+  const Eigen::Matrix3d& r = target_from_source.linear();
+  const Eigen::Vector3d& t = target_from_source.translation();
   for (std::size_t i = 0; i < in.size(); ++i) {
-    const auto [x, y, z] = transform_point<Scalar>(target_from_source, in[i].x, in[i].y, in[i].z);
-    out[i].x = x;
-    out[i].y = y;
-    out[i].z = z;
+    const auto x = static_cast<double>(in[i].x);
+    const auto y = static_cast<double>(in[i].y);
+    const auto z = static_cast<double>(in[i].z);
+    out[i].x = static_cast<Scalar>(r(0, 0) * x + r(0, 1) * y + r(0, 2) * z + t.x());
+    out[i].y = static_cast<Scalar>(r(1, 0) * x + r(1, 1) * y + r(1, 2) * z + t.y());
+    out[i].z = static_cast<Scalar>(r(2, 0) * x + r(2, 1) * y + r(2, 2) * z + t.z());
     if constexpr (requires { in[i].intensity; }) out[i].intensity = in[i].intensity;
   }
 }
+
+#if defined(__x86_64__) || defined(__i386__)
+// A point's x', y', z' in the four lanes of one AVX vector: ((r·0 x + r·1 y) + r·2 z) + t, the
+// scalar code's products and sums in its order, without fused multiply-adds (none in this
+// target), so each coordinate rounds exactly as there.
+__attribute__((target("avx"))) void transform_avx(const Eigen::Isometry3d& target_from_source,
+                                                  std::span<const PointXYZI> in, std::span<PointXYZI> out) {
+  const Eigen::Matrix3d& r = target_from_source.linear();
+  const Eigen::Vector3d& t = target_from_source.translation();
+  const __m256d c0 = _mm256_setr_pd(r(0, 0), r(1, 0), r(2, 0), 0.0);
+  const __m256d c1 = _mm256_setr_pd(r(0, 1), r(1, 1), r(2, 1), 0.0);
+  const __m256d c2 = _mm256_setr_pd(r(0, 2), r(1, 2), r(2, 2), 0.0);
+  const __m256d c3 = _mm256_setr_pd(t.x(), t.y(), t.z(), 0.0);
+  static_assert(sizeof(PointXYZI) == 4 * sizeof(float));
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const __m128 p = _mm_loadu_ps(&in[i].x);                // x y z intensity
+    const __m256d d = _mm256_cvtps_pd(p);                   // exact
+    const __m256d lo = _mm256_permute2f128_pd(d, d, 0x00);  // x y x y
+    const __m256d hi = _mm256_permute2f128_pd(d, d, 0x11);  // z i z i
+    const __m256d x = _mm256_permute_pd(lo, 0x0);           // x x x x
+    const __m256d y = _mm256_permute_pd(lo, 0xF);           // y y y y
+    const __m256d z = _mm256_permute_pd(hi, 0x0);           // z z z z
+    __m256d v = _mm256_add_pd(_mm256_mul_pd(c0, x), _mm256_mul_pd(c1, y));
+    v = _mm256_add_pd(_mm256_add_pd(v, _mm256_mul_pd(c2, z)), c3);
+    _mm_storeu_ps(&out[i].x, _mm_blend_ps(_mm256_cvtpd_ps(v), p, 0x8));  // intensity as it was
+  }
+}
+#endif
 
 }  // namespace
 
 void transform_points(const Eigen::Isometry3d& target_from_source, std::span<const PointXYZI> in,
                       std::span<PointXYZI> out) {
+  assert(in.size() == out.size());
+#if defined(__x86_64__) || defined(__i386__)
+  if (__builtin_cpu_supports("avx")) {
+    transform_avx(target_from_source, in, out);
+    return;
+  }
+#endif
+  transform_impl(target_from_source, in, out);
+}
+
+void transform_points_scalar(const Eigen::Isometry3d& target_from_source, std::span<const PointXYZI> in,
+                             std::span<PointXYZI> out) {
   transform_impl(target_from_source, in, out);
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "trajroi/pose/attitude.hpp"
 #include "trajroi/pose/geodetic.hpp"
@@ -204,6 +205,44 @@ TEST(PoseBuffer, InterpolatesPositionAndSlerpsAttitude) {
   ASSERT_TRUE(q.valid()) << to_string(q.status);
   EXPECT_TRUE(q.global_from_robot.translation().isApprox(Eigen::Vector3d(0.25, 0.5, 0.0), 1e-12));
   EXPECT_NEAR(roll_pitch_yaw(Eigen::Quaterniond(q.global_from_robot.linear())).yaw_rad, M_PI / 8, 1e-12);
+}
+
+// The buffer takes the attitude pair's part of the slerp once per sample: every interpolated
+// attitude must still be exactly Eigen's slerp of the two samples (bit for bit), for pairs far
+// apart, close together, identical, and on opposite hemispheres (negative dot product), in a
+// ring that has wrapped.
+TEST(PoseBuffer, AttitudesAreExactlyEigensSlerp) {
+  PoseBuffer buf(PoseGate{}, Eigen::Vector3d::Zero(), 8);
+  ASSERT_TRUE(buf.add_fix(fix(0, 0.0, 0.0)));
+  std::vector<Eigen::Quaterniond> q;
+  const auto turned = [](double roll, double pitch, double yaw) {
+    return Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                              Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                              Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()));
+  };
+  for (int i = 0; i < 20; ++i) {
+    Eigen::Quaterniond next = turned(0.01 * i, -0.02 * i, 0.3 * i);
+    if (i == 5) next = q.back();                                 // no rotation at all
+    if (i == 6) next = turned(0.05, -0.1, 1.5 + 1e-9);           // a tiny step
+    if (i % 4 == 3) next.coeffs() = -next.coeffs();              // the same rotation, other sign
+    if (i == 10) next = Eigen::Quaterniond(0.6, 0.0, 0.8, 0.0);  // a large turn
+    q.push_back(next);
+    ASSERT_TRUE(buf.add_attitude({i * 10'000'000, next}));
+  }
+  ASSERT_TRUE(buf.add_fix(fix(1000, 0.0, 0.0)));
+  for (int i = 12; i < 19; ++i) {  // the ring of 8 holds samples 12 … 19
+    for (const double w : {0.0, 0.1, 0.5, 0.73, 0.999}) {
+      const auto t = static_cast<std::int64_t>((i + w) * 10'000'000);
+      const PoseQuery p = buf.pose_at(t);
+      ASSERT_TRUE(p.valid()) << to_string(p.status);
+      const double exact_w = static_cast<double>(t - i * 10'000'000) / 10'000'000.0;
+      const Eigen::Matrix3d expected = q[static_cast<std::size_t>(i)]
+                                           .normalized()
+                                           .slerp(exact_w, q[static_cast<std::size_t>(i) + 1].normalized())
+                                           .toRotationMatrix();
+      EXPECT_EQ(p.global_from_robot.linear(), expected) << "sample " << i << " w " << w;
+    }
+  }
 }
 
 TEST(PoseBuffer, LeverArmIsRotatedWithTheRobot) {

@@ -32,7 +32,7 @@ StreamDecoder::StreamDecoder(const Calibration& calibration, StreamOptions optio
   if (options_.cut_azimuth_deg < 0.0) options_.cut_azimuth_deg += 360.0;
   held_.reserve(ModelCheck::kMaxUndecided);
   frame_.points.reserve(kFrameReserve);
-  scratch_.reserve(kBlocks * kFiringsPerBlock * kLasers);
+  carried_.reserve(kBlocks * kFiringsPerBlock * kLasers);
 }
 
 void StreamDecoder::on_data_packet(std::span<const std::uint8_t> payload, std::int64_t receive_time_ns,
@@ -177,41 +177,36 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   const std::uint32_t span_cdeg = azimuth_gap(first_azimuth, block_azimuth(packet, last_firing_block));
   rate_cdeg_per_us_ = static_cast<double>(span_cdeg) / (static_cast<double>(kBlocks / step - 1) * kBlockDuration_us);
 
-  decode_to_scratch(packet);
   product_id_ = vlp16::product_id(packet);
   return_mode_ = mode;
 
-  // Each point goes to the frame, which ends where the azimuth passes the cut. The frame's
-  // array is grown for the whole packet up front and the loop's state kept in locals (written
-  // back around the rare end of a frame), so that nothing but the point is stored per point.
-  const std::size_t n = scratch_.size();
+  // The points are decoded straight onto the frame and then placed there (time after the
+  // frame's start); where the azimuth passes the cut, the rest of the packet moves to the next
+  // frame. The loop keeps its state in locals, written back around the rare end of a frame.
   std::vector<Point>& points = frame_.points;
-  std::size_t used = points.size();
-  points.resize(used + n);
+  std::size_t i = points.size();
+  decode_into(packet, points);
   std::int64_t end_time_ns = frame_.end_time_ns;
   double last_phase_deg = last_phase_deg_;
   bool have_phase = have_phase_;
-  const auto finish = [&](std::size_t i, bool partial) {
-    points.resize(used);
-    frame_.end_time_ns = end_time_ns;
-    finish_frame(sink, partial);
-    used = 0;
-    points.resize(n - i);
-  };
   bool counted = false;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Point& point = scratch_[i];
-    double phase = static_cast<double>(point.azimuth_deg) - options_.cut_azimuth_deg;
+  while (i < points.size()) {
+    double phase = static_cast<double>(points[i].azimuth_deg) - options_.cut_azimuth_deg;
     if (phase < 0.0) phase += 360.0;
-    const std::int64_t t = time_ns + point.time_offset_ns;
-    if (have_phase && phase < last_phase_deg - 180.0) {
-      finish(i, false);
-    } else if (used > 0 && t - frame_.start_time_ns > kMaxFrameDuration_ns) {
-      finish(i, true);
+    const std::int64_t t = time_ns + points[i].time_offset_ns;
+    const bool cut = have_phase && phase < last_phase_deg - 180.0;
+    if (cut || (i > 0 && t - frame_.start_time_ns > kMaxFrameDuration_ns)) {
+      carried_.assign(points.begin() + static_cast<std::ptrdiff_t>(i), points.end());
+      points.resize(i);
+      frame_.end_time_ns = end_time_ns;
+      finish_frame(sink, !cut);
+      points.assign(carried_.begin(), carried_.end());
+      i = 0;
     }
     last_phase_deg = phase;
     have_phase = true;
-    if (used == 0) {
+    Point& point = points[i];
+    if (i == 0) {
       frame_.start_time_ns = t;
       end_time_ns = t;
       frame_.start_utc_ns = utc_ns ? std::optional(*utc_ns + point.time_offset_ns) : std::nullopt;
@@ -221,10 +216,9 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
       ++frame_.packets;
       counted = true;
     }
-    Point& placed = points[used++];
-    placed = point;
-    placed.time_offset_ns = static_cast<std::uint32_t>(t - frame_.start_time_ns);
+    point.time_offset_ns = static_cast<std::uint32_t>(t - frame_.start_time_ns);
     end_time_ns = std::max(end_time_ns, t);
+    ++i;
   }
   frame_.end_time_ns = end_time_ns;
   last_phase_deg_ = last_phase_deg;
@@ -233,9 +227,8 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   report_points(sink);
 }
 
-void StreamDecoder::decode_to_scratch(std::span<const std::uint8_t> packet) {
-  scratch_.clear();
-  const PacketDecoder::Result r = decoder_.decode(packet, scratch_);
+void StreamDecoder::decode_into(std::span<const std::uint8_t> packet, std::vector<Point>& points) {
+  const PacketDecoder::Result r = decoder_.decode(packet, points);
   ++counters_.decoded_packets;
   counters_.points += r.points;
   counters_.no_return += r.no_return;
@@ -256,12 +249,13 @@ void StreamDecoder::append_late(std::span<const std::uint8_t> packet, std::int64
     ++counters_.late_dropped;
     return;
   }
-  decode_to_scratch(packet);
+  const std::size_t first = frame_.points.size();
+  decode_into(packet, frame_.points);
   ++frame_.packets;
-  for (const Point& point : scratch_) {
+  for (std::size_t i = first; i < frame_.points.size(); ++i) {
+    Point& point = frame_.points[i];
     const std::int64_t t = packet_time_ns + point.time_offset_ns;
-    Point& placed = frame_.points.emplace_back(point);
-    placed.time_offset_ns = static_cast<std::uint32_t>(t - frame_.start_time_ns);
+    point.time_offset_ns = static_cast<std::uint32_t>(t - frame_.start_time_ns);
     frame_.end_time_ns = std::max(frame_.end_time_ns, t);
   }
   report_points(sink);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 
 namespace trajroi::pose {
@@ -128,9 +129,22 @@ bool PoseBuffer::add_attitude(const AttitudeSample& a) noexcept {
     ++counters_.out_of_order;
     return false;
   }
-  AttitudeSample normalized = a;
-  normalized.global_from_robot.normalize();
-  attitudes_.push(normalized);
+  StoredAttitude stored;
+  stored.t_ns = a.t_ns;
+  stored.global_from_robot = a.global_from_robot.normalized();
+  if (attitudes_.size > 0) {
+    // As Eigen's slerp computes them (Quaternion.h), so that interpolating gives its results.
+    const Eigen::Quaterniond& previous = attitudes_.newest().global_from_robot;
+    SlerpPair& pair = stored.from_previous;
+    pair.dot = previous.dot(stored.global_from_robot);
+    const double abs_dot = std::abs(pair.dot);
+    pair.linear = abs_dot >= 1.0 - std::numeric_limits<double>::epsilon();
+    if (!pair.linear) {
+      pair.theta = std::acos(abs_dot);
+      pair.sin_theta = std::sin(pair.theta);
+    }
+  }
+  attitudes_.push(stored);
   ++counters_.attitudes;
   return true;
 }
@@ -219,12 +233,21 @@ PoseQuery PoseBuffer::pose_at(std::int64_t t_ns) const noexcept {
   }
   const AttitudeSample& qa = attitudes_.at(r);
   if (r + 1 < attitudes_.size) {
-    const AttitudeSample& qb = attitudes_.at(r + 1);
+    const StoredAttitude& qb = attitudes_.at(r + 1);
     if (qb.t_ns - qa.t_ns > gate_.max_gap_ns) {
       return fail(PoseStatus::kAttitudeGap, qb.t_ns - qa.t_ns, gate_.max_gap_ns);
     }
     const double w = static_cast<double>(t_ns - qa.t_ns) / static_cast<double>(qb.t_ns - qa.t_ns);
-    attitude = qa.global_from_robot.slerp(w, qb.global_from_robot);
+    // qa.slerp(w, qb) with the pair's part taken from qb.
+    const SlerpPair& pair = qb.from_previous;
+    double scale0 = 1.0 - w;
+    double scale1 = w;
+    if (!pair.linear) {
+      scale0 = std::sin((1.0 - w) * pair.theta) / pair.sin_theta;
+      scale1 = std::sin(w * pair.theta) / pair.sin_theta;
+    }
+    if (pair.dot < 0.0) scale1 = -scale1;
+    attitude = Eigen::Quaterniond(scale0 * qa.global_from_robot.coeffs() + scale1 * qb.global_from_robot.coeffs());
   } else {
     if (t_ns - qa.t_ns > gate_.max_extrapolation_ns) {
       return fail(PoseStatus::kAttitudeTooOld, t_ns - qa.t_ns, gate_.max_extrapolation_ns);

@@ -1,7 +1,6 @@
 #pragma once
 
 #include <Eigen/Geometry>
-#include <array>
 #include <span>
 
 #include "trajroi/roi/point.hpp"
@@ -27,25 +26,14 @@ namespace trajroi::roi {
 
 // out[i] = target_from_source · in[i] for every point, computed in double and stored in the
 // output's precision; intensity is copied. `in` and `out` must have the same size and may be
-// the same array (in-place). Allocates nothing.
+// the same array (in-place). Allocates nothing. On a CPU with AVX, PointXYZI clouds take a
+// vector path doing the same double operations in the same order (bit-identical results).
 void transform_points(const Eigen::Isometry3d& target_from_source, std::span<const PointXYZI> in,
                       std::span<PointXYZI> out);
 void transform_points(const Eigen::Isometry3d& target_from_source, std::span<const PointXYZd> in,
                       std::span<PointXYZd> out);
-
-// One point as transform_points computes it (in double, each coordinate rounded once), for
-// callers whose points come in another layout.
-template <typename Scalar, typename In>
-[[nodiscard]] inline std::array<Scalar, 3> transform_point(const Eigen::Isometry3d& target_from_source, In x_in,
-                                                           In y_in, In z_in) noexcept {
-  const Eigen::Matrix3d& r = target_from_source.linear();
-  const Eigen::Vector3d& t = target_from_source.translation();
-  const auto x = static_cast<double>(x_in);
-  const auto y = static_cast<double>(y_in);
-  const auto z = static_cast<double>(z_in);
-  return {static_cast<Scalar>(r(0, 0) * x + r(0, 1) * y + r(0, 2) * z + t.x()),
-          static_cast<Scalar>(r(1, 0) * x + r(1, 1) * y + r(1, 2) * z + t.y()),
-          static_cast<Scalar>(r(2, 0) * x + r(2, 1) * y + r(2, 2) * z + t.z())};
-}
+// The scalar code alone, whatever the CPU: the reference the vector path is tested against.
+void transform_points_scalar(const Eigen::Isometry3d& target_from_source, std::span<const PointXYZI> in,
+                             std::span<PointXYZI> out);
 
 }  // namespace trajroi::roi

@@ -129,7 +129,8 @@ class StreamDecoder {
 
  private:
   void accept(std::span<const std::uint8_t> packet, std::int64_t receive_time_ns, FrameSink& sink);
-  void decode_to_scratch(std::span<const std::uint8_t> packet);  // and count what it held
+  // Appends the packet's points (time after the packet's first firing) and counts them.
+  void decode_into(std::span<const std::uint8_t> packet, std::vector<Point>& points);
   void append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns, FrameSink& sink);
   std::int64_t packet_time_ns(std::uint32_t toh_us, std::int64_t receive_time_ns, double period_us);
   void finish_frame(FrameSink& sink, bool partial);
@@ -163,7 +164,7 @@ class StreamDecoder {
   std::size_t reported_ = 0;  // points of frame_ handed to on_points
   bool first_frame_ = true;
   std::uint64_t next_index_ = 0;
-  std::vector<Point> scratch_;
+  std::vector<Point> carried_;  // a packet's points after a frame's end, to the next frame
 
   std::optional<std::uint8_t> product_id_;
   std::optional<ReturnMode> return_mode_;

@@ -127,10 +127,23 @@ class PoseBuffer {
   // kValid, or the failing status with its figure and limit in `out`.
   [[nodiscard]] PoseStatus check(const FixQuality& q, PoseQuery& out) const noexcept;
 
+  // The parts of Eigen's slerp (Quaternion.h) that depend only on the two attitudes: their
+  // dot product, the angle between them and its sine. Each attitude keeps those of the pair it
+  // ends, taken once as it arrives instead of at every interpolation inside the pair.
+  struct SlerpPair {
+    double dot = 1.0;
+    double theta = 0.0;
+    double sin_theta = 0.0;
+    bool linear = true;  // |dot| ≥ 1 − ε: Eigen interpolates the coefficients linearly
+  };
+  struct StoredAttitude : AttitudeSample {
+    SlerpPair from_previous;
+  };
+
   PoseGate gate_;
   Eigen::Vector3d antenna_in_robot_m_;
   Ring<GnssFix> fixes_;
-  Ring<AttitudeSample> attitudes_;
+  Ring<StoredAttitude> attitudes_;
   PoseBufferCounters counters_;
   std::optional<Eigen::Isometry3d> held_;
 };
