@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <numbers>
+#include <random>
+#include <vector>
 
 namespace trajroi::roi {
 namespace {
@@ -25,6 +28,25 @@ TEST(Transform, ComposesGlobalFromRobotAndRobotFromSensor) {
   EXPECT_NEAR(out[1].y, 6.0f, 1e-5f);
   EXPECT_NEAR(out[1].z, 0.0f, 1e-5f);
   EXPECT_EQ(out[1].intensity, 8.0f);
+}
+
+// Whatever path the CPU takes (AVX here when it has it), every coordinate is the scalar
+// code's to the bit: LiDAR-range and far-from-origin points, tilted poses, odd counts.
+TEST(Transform, EveryPathGivesTheScalarBits) {
+  std::mt19937 rng(20);
+  std::uniform_real_distribution<float> coordinate(-120.0f, 120.0f);
+  std::uniform_real_distribution<double> angle(-std::numbers::pi, std::numbers::pi);
+  for (const std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{7}, std::size_t{384}, std::size_t{1001}}) {
+    Eigen::Isometry3d pose =
+        pose_from_xyz_rpy(Eigen::Vector3d(4321.123, -987.654, 12.5), 0.1 * angle(rng), 0.1 * angle(rng), angle(rng));
+    std::vector<PointXYZI> in(n);
+    for (PointXYZI& p : in)
+      p = {coordinate(rng), coordinate(rng), 0.1f * coordinate(rng), static_cast<float>(rng() % 256)};
+    std::vector<PointXYZI> fast(n), scalar(n);
+    transform_points(pose, in, fast);
+    transform_points_scalar(pose, in, scalar);
+    ASSERT_EQ(0, std::memcmp(fast.data(), scalar.data(), n * sizeof(PointXYZI))) << n << " points";
+  }
 }
 
 TEST(Transform, InPlaceEqualsOutOfPlace) {
