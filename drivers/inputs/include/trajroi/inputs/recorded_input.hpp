@@ -33,8 +33,11 @@ class RecordedInput final : public InputSource {
   [[nodiscard]] InputCounters counters() const noexcept override;
   [[nodiscard]] std::string describe() const override;
 
-  // Items due within this much of now go out together (one wake-up of the consumer).
-  static constexpr std::int64_t kPacingQuantum_ns = 2'000'000;
+  // Items due within this much of now go out together (one wake-up of the consumer). Small,
+  // so that a paced replay hands packets over when the sensor would: with 2 ms, the last packet
+  // of a sweep went out up to 2 ms before its time and the packet that closes the sweep in the
+  // next batch, which the latency (last packet → LCM) counted as the pipeline's.
+  static constexpr std::int64_t kPacingQuantum_ns = 200'000;
 
  private:
   std::filesystem::path dir_;
