@@ -5,11 +5,7 @@
 # sweep → LCM publication), ring and kernel drops, as the daemon's own once-a-minute line
 # reports them. Passes when memory stays within 5 % of the first minute's and nothing is
 # dropped.
-# With SOAK_REALTIME=1 the daemon runs as systemd/realtime.conf allows on a robot: its threads
-# SCHED_FIFO (replay reader standing in for the LiDAR 60, processing 50, publisher 40) and its
-# memory locked; that needs root or CAP_SYS_NICE + CAP_IPC_LOCK (otherwise the daemon warns and
-# runs SCHED_OTHER, and this script says so).
-# Usage: [SOAK_REALTIME=1] scripts/soak.sh [MINUTES=10] [RATE=10] [BUILD_DIR=build/release]
+# Usage: scripts/soak.sh [MINUTES=10] [RATE=10] [BUILD_DIR=build/release]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 minutes=${1:-10}
@@ -32,18 +28,11 @@ lap_s=$(awk '/^duration_s/ {print $2}' "$work/run/summary.txt")
 cp "$work/run/trajroid.yaml" "$work/run/soak.yaml"
 printf 'lcm:\n  channels: {points: SOAK_POINTS, pose: SOAK_POSE, roi: SOAK_ROI, status: SOAK_STATUS, trajectory: SOAK_TRAJECTORY}\n' \
   >>"$work/run/soak.yaml"
-scheduling="SCHED_OTHER (the configuration's default)"
-if [ "${SOAK_REALTIME:-0}" = 1 ]; then
-  printf 'realtime:\n  lock_memory: true\n  threads:\n    lidar: {policy: fifo, priority: 60}\n    processing: {policy: fifo, priority: 50}\n    publisher: {policy: fifo, priority: 40}\n' \
-    >>"$work/run/soak.yaml"
-  scheduling="SCHED_FIFO (reader 60, processing 50, publisher 40), memory locked"
-fi
 
 "$build/daemon/trajroid" --config "$work/run/soak.yaml" --replay "$work/run" --loop --rate "$rate" \
   --lcm-url 'udpm://239.255.76.67:7667?ttl=0' 2>"$work/trajroid.log" &
 daemon_pid=$!
 echo "soak: corridor run (${lap_s} s of dual-return data a lap) looped at ${rate}x real time for ${minutes} min"
-echo "soak: threads ${scheduling}; machine: $(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1), $(nproc) cores"
 printf '%-6s %9s %8s %9s %10s %10s %10s %10s %10s\n' minute "RSS MiB" sweeps published "p50 ms" "p99 ms" "max ms" \
   "ring drop" "kern drop"
 rss_mib() { awk '/^VmRSS:/ {printf "%.1f", $2 / 1024}' "/proc/$daemon_pid/status"; }
@@ -79,9 +68,6 @@ done
 kill -TERM "$daemon_pid"
 wait "$daemon_pid" || true
 daemon_pid=
-if grep -E 'refused|not set' "$work/trajroid.log" >&2; then
-  echo "soak: the realtime settings above were refused: the threads ran SCHED_OTHER" >&2
-fi
 summary=$(grep 'summary:' "$work/trajroid.log" || true)
 echo "soak: $(sed 's/.*summary: //' <<<"$summary")"
 laps=$(grep -c 'replay: lap' "$work/trajroid.log" || true)

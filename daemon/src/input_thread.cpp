@@ -2,13 +2,11 @@
 // object differs (inputs::UdpInput, inputs::SerialInput or inputs::RecordedInput).
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <thread>
 
 #include "log.hpp"
 #include "realtime.hpp"
 #include "threads.hpp"
-#include "trajroi/vlp16/packet.hpp"
 
 namespace trajroi::daemon {
 
@@ -24,19 +22,6 @@ void copy_counters(const inputs::InputSource& source, InputLane& lane) {
   lane.kernel_drops.store(c.kernel_drops, std::memory_order_relaxed);
 }
 
-// Whether a LiDAR data packet may close a sweep: its first azimuth within this much of the cut
-// (either side; a packet spans at most 4.8°: strongest return at 20 Hz).
-constexpr std::uint32_t kNearCut_cdeg = 500;
-
-bool near_cut(const inputs::InputItem& item, std::uint32_t cut_cdeg) noexcept {
-  if (item.stream != inputs::Stream::kLidarData || item.bytes.size() < vlp16::kDataPacketBytes) return false;
-  const std::uint32_t azimuth = vlp16::block_azimuth(item.bytes, 0);
-  return vlp16::azimuth_gap(static_cast<std::uint16_t>(azimuth % vlp16::kAzimuthLimit),
-                            static_cast<std::uint16_t>(cut_cdeg)) <= kNearCut_cdeg ||
-         vlp16::azimuth_gap(static_cast<std::uint16_t>(cut_cdeg),
-                            static_cast<std::uint16_t>(azimuth % vlp16::kAzimuthLimit)) <= kNearCut_cdeg;
-}
-
 }  // namespace
 
 void input_loop(Pipeline& pipeline, InputLane& lane) {
@@ -46,20 +31,10 @@ void input_loop(Pipeline& pipeline, InputLane& lane) {
   inputs::InputSource& source = *lane.source;
   Ring<InputSlot>& ring = *lane.ring;
   log::RateLimited error_limit(pipeline.config.logging.warning_interval_s);
-  // The processing thread is woken once per batch of items, not per item: items that arrive
-  // together go together (capped, so a replay running behind still wakes it); an item alone
-  // waits up to kMaxHold_ns for company, unless it is a LiDAR packet that may close a sweep,
-  // whose latency is the daemon's (it goes at once, with the items held before it). A sweep's
-  // other packets cost no wake-up of their own: at 1 500 packets/s that was most of the
-  // processing thread's CPU at real time.
-  // At most a quarter of the ring is held back (a small configured ring still never fills
-  // while the processing thread sleeps).
-  const auto max_batch = static_cast<int>(std::min<std::size_t>(64, std::max<std::size_t>(1, ring.capacity() / 4)));
-  constexpr std::int64_t kMaxHold_ns = 10'000'000;
-  const double cut_deg = std::fmod(std::fmod(pipeline.config.lidar.cut_azimuth_deg, 360.0) + 360.0, 360.0);
-  const auto cut_cdeg = static_cast<std::uint32_t>(std::lround(cut_deg * 100.0)) % vlp16::kAzimuthLimit;
+  // A paced replay hands items over in batches (one wake-up each); a batch is capped so a
+  // replay running behind still wakes the processing thread.
+  constexpr int kMaxBatch = 16;
   int unnotified = 0;
-  std::int64_t held_since_ns = 0;
   std::uint32_t items = 0;
   const auto on_full = [&pipeline] {
     pipeline.process_wake.notify();
@@ -67,11 +42,7 @@ void input_loop(Pipeline& pipeline, InputLane& lane) {
   };
   inputs::InputItem item;
   while (!pipeline.stop.load(std::memory_order_relaxed)) {
-    // Held items bound the wait: they go when their time is up even if nothing follows.
-    std::int64_t wait_ms = kIdleWait_ms;
-    if (unnotified > 0)
-      wait_ms = std::max<std::int64_t>(1, (held_since_ns + kMaxHold_ns - steady_ns() + 999'999) / 1'000'000);
-    const auto next = source.next(item, std::chrono::milliseconds(wait_ms));
+    const auto next = source.next(item, std::chrono::milliseconds(kIdleWait_ms));
     if (next != inputs::InputSource::Next::kItem) {
       copy_counters(source, lane);
       if (unnotified > 0) {
@@ -117,9 +88,7 @@ void input_loop(Pipeline& pipeline, InputLane& lane) {
       if (!pushed) lane.ring_drops[static_cast<std::size_t>(item.stream)].fetch_add(1, std::memory_order_relaxed);
     } while (!rest.empty());
     if ((++items & 255U) == 0) copy_counters(source, lane);  // current under constant traffic
-    if (unnotified++ == 0) held_since_ns = steady_ns();
-    if (unnotified >= max_batch ||
-        (!source.ready() && (near_cut(item, cut_cdeg) || steady_ns() - held_since_ns >= kMaxHold_ns))) {
+    if (!source.ready() || ++unnotified >= kMaxBatch) {
       pipeline.process_wake.notify();
       unnotified = 0;
     }
