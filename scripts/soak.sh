@@ -33,6 +33,7 @@ printf 'lcm:\n  channels: {points: SOAK_POINTS, pose: SOAK_POSE, roi: SOAK_ROI, 
   --lcm-url 'udpm://239.255.76.67:7667?ttl=0' 2>"$work/trajroid.log" &
 daemon_pid=$!
 echo "soak: corridor run (${lap_s} s of dual-return data a lap) looped at ${rate}x real time for ${minutes} min"
+echo "soak: machine: $(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1), $(nproc) cores"
 printf '%-6s %9s %8s %9s %10s %10s %10s %10s %10s\n' minute "RSS MiB" sweeps published "p50 ms" "p99 ms" "max ms" \
   "ring drop" "kern drop"
 rss_mib() { awk '/^VmRSS:/ {printf "%.1f", $2 / 1024}' "/proc/$daemon_pid/status"; }
