@@ -106,7 +106,6 @@ PacketDecoder::PacketDecoder(const Calibration& calibration, DecodeOptions optio
                        std::sin(cal.vert_angle_rad),
                        std::cos(cal.rot_correction_rad),
                        std::sin(cal.rot_correction_rad),
-                       cal.vert_offset_m,
                        cal.horiz_offset_m,
                        cal.dist_correction_m,
                        cal.vert_offset_m * std::sin(cal.vert_angle_rad),

@@ -185,7 +185,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   // frame. The loop keeps its state in locals, written back around the rare end of a frame.
   std::vector<Point>& points = frame_.points;
   std::size_t i = points.size();
-  decode_into(packet, points);
+  decode_onto_frame(packet);
   std::int64_t end_time_ns = frame_.end_time_ns;
   double last_phase_deg = last_phase_deg_;
   bool have_phase = have_phase_;
@@ -227,8 +227,8 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   report_points(sink);
 }
 
-void StreamDecoder::decode_into(std::span<const std::uint8_t> packet, std::vector<Point>& points) {
-  const PacketDecoder::Result r = decoder_.decode(packet, points);
+void StreamDecoder::decode_onto_frame(std::span<const std::uint8_t> packet) {
+  const PacketDecoder::Result r = decoder_.decode(packet, frame_.points);
   ++counters_.decoded_packets;
   counters_.points += r.points;
   counters_.no_return += r.no_return;
@@ -250,7 +250,7 @@ void StreamDecoder::append_late(std::span<const std::uint8_t> packet, std::int64
     return;
   }
   const std::size_t first = frame_.points.size();
-  decode_into(packet, frame_.points);
+  decode_onto_frame(packet);
   ++frame_.packets;
   for (std::size_t i = first; i < frame_.points.size(); ++i) {
     Point& point = frame_.points[i];

@@ -92,8 +92,8 @@ class PacketDecoder {
   struct Laser {
     double cos_vert, sin_vert;
     double cos_rot, sin_rot;
-    double vert_offset_m, horiz_offset_m, dist_correction_m;
-    double offset_sin_vert, offset_cos_vert;  // vert_offset_m · sin_vert, · cos_vert
+    double horiz_offset_m, dist_correction_m;
+    double offset_sin_vert, offset_cos_vert;  // the vertical offset · sin_vert, · cos_vert
     std::uint8_t ring;
   };
   // Per channel of one firing (pair): cos θ, sin θ of its direction and the azimuth it reports.

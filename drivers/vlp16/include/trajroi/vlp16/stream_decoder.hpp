@@ -129,8 +129,8 @@ class StreamDecoder {
 
  private:
   void accept(std::span<const std::uint8_t> packet, std::int64_t receive_time_ns, FrameSink& sink);
-  // Appends the packet's points (time after the packet's first firing) and counts them.
-  void decode_into(std::span<const std::uint8_t> packet, std::vector<Point>& points);
+  // Appends the packet's points to the frame (time after the packet's first firing) and counts them.
+  void decode_onto_frame(std::span<const std::uint8_t> packet);
   void append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns, FrameSink& sink);
   std::int64_t packet_time_ns(std::uint32_t toh_us, std::int64_t receive_time_ns, double period_us);
   void finish_frame(FrameSink& sink, bool partial);

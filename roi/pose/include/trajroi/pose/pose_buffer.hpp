@@ -161,7 +161,7 @@ class FiringPoses {
       : buffer_(&buffer), robot_from_sensor_(robot_from_sensor), period_ns_(period_ns) {}
 
   // global_from_sensor at t, or nullptr when the pose is not valid (`status` says why). A new
-  // query is made when t leaves [t_query, t_query + period); generation() then grows.
+  // query is made when t leaves [t_query, t_query + period) (covers() says whether it would).
   [[nodiscard]] const Eigen::Isometry3d* at(std::int64_t t_ns, PoseStatus& status) noexcept {
     if (!have_ || t_ns < query_ns_ || t_ns - query_ns_ >= period_ns_) {
       const PoseQuery q = buffer_->pose_at(t_ns);
@@ -170,7 +170,6 @@ class FiringPoses {
       limit_ = q.limit;
       have_ = true;
       query_ns_ = t_ns;
-      ++generation_;
       if (q.valid()) global_from_sensor_ = q.global_from_robot * robot_from_sensor_;
     }
     status = status_;
@@ -180,7 +179,6 @@ class FiringPoses {
   [[nodiscard]] bool covers(std::int64_t t_ns) const noexcept {
     return have_ && t_ns >= query_ns_ && t_ns - query_ns_ < period_ns_;
   }
-  [[nodiscard]] std::uint64_t generation() const noexcept { return generation_; }
   // The last query's failing figure and its limit (PoseQuery::measured, limit).
   [[nodiscard]] double measured() const noexcept { return measured_; }
   [[nodiscard]] double limit() const noexcept { return limit_; }
@@ -192,7 +190,6 @@ class FiringPoses {
   std::int64_t period_ns_;
   bool have_ = false;
   std::int64_t query_ns_ = 0;
-  std::uint64_t generation_ = 0;
   PoseStatus status_ = PoseStatus::kNoGnss;
   double measured_ = 0.0, limit_ = 0.0;
   Eigen::Isometry3d global_from_sensor_ = Eigen::Isometry3d::Identity();
