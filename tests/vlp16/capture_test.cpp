@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <set>
@@ -194,6 +195,55 @@ INSTANTIATE_TEST_SUITE_P(
                                     "product id 0x21 (HDL-32E) is not supported"},
                     RejectedCapture{"velodyne/other_models/nebula_vlp32c_strongest_1713492677.DERIVED.pcap", 379,
                                     "product id 0x28 (VLP-32C) is not supported"}));
+
+// The reader thread's early wake-up: every whole frame the decoder completes on a real capture
+// is completed by a packet may_complete_frame foresaw, at cuts all round; and it foresees few
+// (a packet or two per sweep; a wake-up per packet is what it saves). The strongest-return and
+// the dual-return capture (the 2018 example holds less than a sweep).
+class Vlp16ForeseesFrameEnds : public testing::TestWithParam<const char*> {};
+
+TEST_P(Vlp16ForeseesFrameEnds, EveryWholeFrameEndsOnAForeseenPacket) {
+  TRAJROI_REQUIRE_DATA(path, GetParam());
+  struct Ends final : FrameSink {
+    std::size_t whole = 0;
+    void on_frame(const Frame& frame) override { whole += frame.partial ? 0 : 1; }
+  };
+  for (const double cut : {0.0, 90.0, 180.5, 271.37, 359.99, -45.0}) {
+    PcapSource source(path);
+    StreamOptions options;
+    options.cut_azimuth_deg = cut;
+    StreamDecoder decoder(Calibration::vlp16_default(), options);
+    const std::uint16_t cut_cdeg = cut_centidegrees(cut);
+    Ends ends;
+    std::size_t packets = 0, foreseen = 0;
+    Datagram datagram;
+    while (source.next(datagram) == PacketSource::Next::kDatagram) {
+      if (datagram.destination_port == kPositionPort) continue;
+      ++packets;
+      const bool may_end = may_complete_frame(datagram.payload, cut_cdeg);
+      foreseen += may_end ? 1 : 0;
+      const std::size_t before = ends.whole;
+      decoder.on_data_packet(datagram.payload, datagram.receive_time_ns, ends);
+      if (ends.whole != before) {
+        EXPECT_TRUE(may_end) << "cut " << cut << "°, data packet " << packets;
+      }
+    }
+    EXPECT_GE(ends.whole, 2u) << "cut " << cut << "°";
+    EXPECT_LE(foreseen, 3 * (ends.whole + 1)) << "cut " << cut << "°, " << packets << " packets";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Captures, Vlp16ForeseesFrameEnds,
+                         testing::Values("velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap",
+                                         "velodyne/vlp16/nebula_vlp16_dual_1673400471.DERIVED.pcap"));
+
+TEST(Vlp16Stream, CutCentidegreesWrapsAndRounds) {
+  EXPECT_EQ(cut_centidegrees(0.0), 0);
+  EXPECT_EQ(cut_centidegrees(359.996), 0);
+  EXPECT_EQ(cut_centidegrees(-45.0), 31500);
+  EXPECT_EQ(cut_centidegrees(720.25), 25);
+  EXPECT_EQ(cut_centidegrees(std::numeric_limits<double>::quiet_NaN()), 0);
+}
 
 // nebula's return types (nebula_common.hpp): IDENTICAL 6 when the pair's returns are equal
 // or the other one is empty; otherwise FIRST_* (4, 9) for the farther return, which is the

@@ -19,6 +19,20 @@ std::uint32_t missing(double observed, double expected) noexcept {
 
 }  // namespace
 
+std::uint16_t cut_centidegrees(double cut_azimuth_deg) noexcept {
+  if (!std::isfinite(cut_azimuth_deg)) return 0;
+  const double deg = std::fmod(std::fmod(cut_azimuth_deg, 360.0) + 360.0, 360.0);
+  return static_cast<std::uint16_t>(static_cast<std::uint32_t>(std::lround(deg * 100.0)) % kAzimuthLimit);
+}
+
+bool may_complete_frame(std::span<const std::uint8_t> packet, std::uint16_t cut_cdeg) noexcept {
+  if (packet.size() < kDataPacketBytes) return false;
+  const auto first = static_cast<std::uint16_t>(block_azimuth(packet, 0) % kAzimuthLimit);
+  const auto last = static_cast<std::uint16_t>(block_azimuth(packet, kBlocks - 1) % kAzimuthLimit);
+  return azimuth_gap(first, cut_cdeg) <= azimuth_gap(first, last) + kFrameEndMargin_cdeg ||
+         azimuth_gap(cut_cdeg, first) <= kFrameEndMargin_cdeg;
+}
+
 std::uint64_t StreamCounters::rejected_total() const noexcept {
   std::uint64_t total = 0;
   for (const std::uint64_t n : rejected)

@@ -103,6 +103,19 @@ struct StreamCounters {
   [[nodiscard]] std::uint64_t rejected_total() const noexcept;
 };
 
+// The cut azimuth (StreamOptions::cut_azimuth_deg, any real) in hundredths of a degree, [0, 36000).
+[[nodiscard]] std::uint16_t cut_centidegrees(double cut_azimuth_deg) noexcept;
+
+// Whether a data packet may complete a frame cut at `cut_cdeg`, from its block azimuths alone
+// (no decoding): the cut lies within its azimuths (first block to last, plus
+// kFrameEndMargin_cdeg for the last block's firings), or its first azimuth is at most that far
+// past the cut (the packet after a cut that fell between two packets, or after a lost one). A
+// reader thread wakes its consumer at once for such a packet and lets the others wait for
+// company. False for a packet shorter than a data packet. (A frame cut by
+// kMaxFrameDuration_ns, a stalled motor, is not foreseen.)
+inline constexpr std::uint32_t kFrameEndMargin_cdeg = 100;
+[[nodiscard]] bool may_complete_frame(std::span<const std::uint8_t> packet, std::uint16_t cut_cdeg) noexcept;
+
 class StreamDecoder {
  public:
   StreamDecoder(const Calibration& calibration, StreamOptions options);
