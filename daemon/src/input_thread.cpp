@@ -23,9 +23,15 @@ void copy_counters(const inputs::InputSource& source, InputLane& lane) {
   lane.kernel_drops.store(c.kernel_drops, std::memory_order_relaxed);
 }
 
-// A LiDAR data packet that may close a sweep (vlp16::may_complete_frame).
-bool may_close_sweep(const inputs::InputItem& item, std::uint16_t cut_cdeg) noexcept {
-  return item.stream == inputs::Stream::kLidarData && vlp16::may_complete_frame(item.bytes, cut_cdeg);
+// The processing thread is also woken this far ahead of the cut, so the items held then are
+// handled before the closing packet comes and do not add to its latency.
+constexpr std::uint16_t kDrainAhead_cdeg = 500;
+
+// A LiDAR data packet that may close a sweep (vlp16::may_complete_frame), or that is at the
+// drain point ahead of the cut.
+bool wake_now(const inputs::InputItem& item, std::uint16_t cut_cdeg, std::uint16_t drain_cdeg) noexcept {
+  return item.stream == inputs::Stream::kLidarData &&
+         (vlp16::may_complete_frame(item.bytes, cut_cdeg) || vlp16::may_complete_frame(item.bytes, drain_cdeg));
 }
 
 }  // namespace
@@ -40,14 +46,16 @@ void input_loop(Pipeline& pipeline, InputLane& lane) {
   // The processing thread is woken once per batch of items, not per item: items that arrive
   // together go together (capped, so a replay running behind still wakes it); an item alone
   // waits up to kMaxHold_ns for company, unless it is a LiDAR packet that may close a sweep,
-  // whose latency is the daemon's (it goes at once, with the items held before it). A sweep's
-  // other packets cost no wake-up of their own: at 1 500 packets/s that was most of the
-  // processing thread's CPU at real time.
+  // whose latency is the daemon's (it goes at once, with the few items held since the drain
+  // ahead of the cut). A sweep's other packets cost no wake-up of their own: at 1 500
+  // packets/s that was most of the processing thread's CPU at real time.
   // At most a quarter of the ring is held back (a small configured ring still never fills
   // while the processing thread sleeps).
   const auto max_batch = static_cast<int>(std::min<std::size_t>(64, std::max<std::size_t>(1, ring.capacity() / 4)));
-  constexpr std::int64_t kMaxHold_ns = 10'000'000;
+  constexpr std::int64_t kMaxHold_ns = 20'000'000;
   const std::uint16_t cut_cdeg = vlp16::cut_centidegrees(pipeline.config.lidar.cut_azimuth_deg);
+  const auto drain_cdeg =
+      static_cast<std::uint16_t>((cut_cdeg + vlp16::kAzimuthLimit - kDrainAhead_cdeg) % vlp16::kAzimuthLimit);
   int unnotified = 0;
   std::int64_t held_since_ns = 0;
   std::uint32_t items = 0;
@@ -108,7 +116,7 @@ void input_loop(Pipeline& pipeline, InputLane& lane) {
     } while (!rest.empty());
     if ((++items & 255U) == 0) copy_counters(source, lane);  // current under constant traffic
     if (unnotified++ == 0) held_since_ns = steady_ns();
-    if (unnotified >= max_batch || may_close_sweep(item, cut_cdeg) ||
+    if (unnotified >= max_batch || wake_now(item, cut_cdeg, drain_cdeg) ||
         (!source.ready() && steady_ns() - held_since_ns >= kMaxHold_ns)) {
       pipeline.process_wake.notify();
       unnotified = 0;
