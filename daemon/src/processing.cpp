@@ -26,6 +26,8 @@ class RingSink final : public SweepSink {
     const auto fill = [&](Sweep& slot) {
       slot = sweep;  // vector assignment within the reserved capacity: no allocation
       slot.processing_ns = accumulated_ns_ + (now - packet_start_ns_);
+      slot.closing_packet_start_ns = packet_start_ns_;
+      slot.handed_over_ns = now;
     };
     const auto on_full = [this] {
       pipeline_.publish_wake.notify();

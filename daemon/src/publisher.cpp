@@ -45,7 +45,8 @@ Publisher::Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, boo
       start_steady_ns_(steady_ns()),
       health_(pipeline.config, !replay, start_steady_ns_),
       sweep_warn_limit_(pipeline.config.logging.warning_interval_s),
-      trajectory_warn_limit_(pipeline.config.logging.warning_interval_s) {
+      trajectory_warn_limit_(pipeline.config.logging.warning_interval_s),
+      late_limit_(pipeline.config.logging.warning_interval_s) {
   // Here, before the loops start: LCM's first subscription runs its self test (up to seconds
   // when its own multicast does not come back), which must not hold up the publishing loop.
   const bool receiving = outlet_.subscribe(config_.lcm.trajectory,
@@ -115,18 +116,37 @@ void Publisher::take_reloads() {
   }
 }
 
+void Publisher::report_late(const Sweep& s, std::int64_t dequeued_ns, std::int64_t encoded_ns, std::int64_t sent_ns) {
+  ++late_sweeps_;
+  std::uint64_t suppressed = 0;
+  if (!late_limit_.allow(sent_ns, suppressed)) return;
+  const auto ms = [](std::int64_t from, std::int64_t to) { return static_cast<double>(to - from) * 1e-6; };
+  log::info(
+      "sweep {} late: {:.2f} ms from its last packet to LCM (waiting for the processing thread {:.2f}, the closing "
+      "packet and hand-over {:.2f}, waiting for the publisher {:.2f}, encoding {:.2f}, sending {:.2f} ms); {} late "
+      "sweeps (over {:.0f} ms) so far{}",
+      s.index, ms(s.last_packet_arrival_ns, sent_ns), ms(s.last_packet_arrival_ns, s.closing_packet_start_ns),
+      ms(s.closing_packet_start_ns, s.handed_over_ns), ms(s.handed_over_ns, dequeued_ns), ms(dequeued_ns, encoded_ns),
+      ms(encoded_ns, sent_ns), late_sweeps_, kLateSweep_ms,
+      suppressed > 0 ? " (" + std::to_string(suppressed) + " late sweeps not described)" : std::string());
+}
+
 void Publisher::publish_sweep(const Sweep& s) {
+  const std::int64_t dequeued_ns = steady_ns();
   fill_pose(s, pose_);
   send(config_.lcm.pose, pose_);
   if (s.filtered) {
     fill_roi(s, roi_);
     send(config_.lcm.roi, roi_);
     encode_points(s, config_.pose_mode, points_, points_encoded_);
+    const std::int64_t encoded_ns = steady_ns();
     outlet_.publish(config_.lcm.points, points_encoded_);
     // A partial sweep's latency (the stream's end, flushed at a stop) is the wait for the stop,
     // not the pipeline's: left out of the figures.
     if (!s.partial) {
-      const double latency_ms = static_cast<double>(steady_ns() - s.last_packet_arrival_ns) * 1e-6;
+      const std::int64_t sent_ns = steady_ns();
+      const double latency_ms = static_cast<double>(sent_ns - s.last_packet_arrival_ns) * 1e-6;
+      if (latency_ms > kLateSweep_ms && !pipeline_.exact) report_late(s, dequeued_ns, encoded_ns, sent_ns);
       if (latency_window_ms_.size() < latency_window_ms_.capacity()) latency_window_ms_.push_back(latency_ms);
       if (latency_minute_ms_.size() < latency_minute_ms_.capacity()) latency_minute_ms_.push_back(latency_ms);
       latency_all_.add(latency_ms);
@@ -181,6 +201,7 @@ void Publisher::publish_status(const StatusSnapshot& s) {
   add("trajectory.accepted", trajectories_accepted_);
   add("trajectory.reloads", trajectory_reloads_);
   add("trajectory.reload_errors", trajectory_reload_errors_);
+  add("sweeps.late", late_sweeps_);
   m.num_counters = static_cast<std::int32_t>(m.counter_names.size());
   send(config_.lcm.status, m);
 

@@ -20,6 +20,9 @@
 
 namespace trajroi::daemon {
 
+// A sweep this late from its last packet to its LCM publication is described in the log.
+inline constexpr double kLateSweep_ms = 5.0;
+
 class Publisher {
  public:
   // `replay`: said in the status message. `reloader` may be null (no SIGHUP reloads).
@@ -34,6 +37,9 @@ class Publisher {
   void on_trajectory_message(std::span<const std::uint8_t> bytes, const std::string& channel);
   void offer(std::unique_ptr<ActiveTrajectory> trajectory);
   void publish_sweep(const Sweep& s);
+  // A sweep later than kLateSweep_ms from its last packet to LCM: where the time went, said at
+  // most once per logging.warning_interval_s (not at --rate max, where the queue is the design).
+  void report_late(const Sweep& s, std::int64_t dequeued_ns, std::int64_t encoded_ns, std::int64_t sent_ns);
   void publish_status(const StatusSnapshot& s);
   void log_minute(const StatusSnapshot& s);
   void take_reloads();
@@ -63,6 +69,8 @@ class Publisher {
   HealthMonitor health_;
   log::RateLimited sweep_warn_limit_;       // withheld sweeps
   log::RateLimited trajectory_warn_limit_;  // rejected trajectory messages: never hidden by the above
+  log::RateLimited late_limit_;             // late sweeps
+  std::uint64_t late_sweeps_ = 0;
 };
 
 }  // namespace trajroi::daemon

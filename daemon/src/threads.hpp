@@ -13,8 +13,9 @@ class SweepProcessor;
 
 // input_thread.cpp: reads one source into its lane's ring until the stop flag or the end of a
 // recording; serial reads longer than a slot are split (same receive time); a datagram longer
-// than a slot is counted and dropped. Wakes the processing thread per item, or once per batch
-// while the source says more items are ready.
+// than a slot is counted and dropped. Wakes the processing thread at once for a LiDAR packet
+// that may close a sweep (and 5° ahead of the cut), otherwise once per batch of items (up to
+// 64, or 20 ms).
 void input_loop(Pipeline& pipeline, InputLane& lane);
 
 // processing.cpp: the items of every lane in their global order through the SweepProcessor,

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <thread>
 #include <vector>
 
 #include "daemon_fixture.hpp"
@@ -252,6 +253,46 @@ TEST(Pipeline, TheEvaluationKeepsExactlyWhatTheDaemonPublishes) {
     points += s.size();
   }
   EXPECT_GT(points, 1'000'000u);
+}
+
+// A sweep later than kLateSweep_ms from its last packet to LCM is counted (sweeps.late) and
+// described: here an outlet that takes 6 ms to send each points message makes every published
+// sweep late, at the sensors' pace (the live path; an as-fast replay's queue is not lateness).
+TEST(Pipeline, LateSweepsAreCounted) {
+  const DaemonConfig config = trajroi::daemon::load_daemon_config(corridor_run() / "trajroid.yaml");
+  class SlowOutlet final : public trajroi::daemon::Outlet {
+   public:
+    explicit SlowOutlet(std::string points) : points_(std::move(points)) {}
+    void publish(const std::string& channel, std::span<const std::uint8_t> bytes) override {
+      if (channel == points_) std::this_thread::sleep_for(std::chrono::milliseconds(6));
+      inner.publish(channel, bytes);
+    }
+    bool subscribe(const std::string&, Handler) override { return true; }
+    [[nodiscard]] int incoming_fd() const noexcept override { return -1; }
+    void handle_incoming() override {}
+    FakeOutlet inner;
+
+   private:
+    std::string points_;
+  } outlet(config.lcm.points);
+  // The run's first 6 s at twice real time, in one paced lane.
+  std::vector<Item> items = run_items({});
+  const std::int64_t end_ns = items.front().t_ns + 6'000'000'000;
+  std::erase_if(items, [end_ns](const Item& i) { return i.t_ns > end_ns; });
+  Pipeline pipeline(config, /*exact=*/false, /*record=*/false);
+  pipeline.add_input(std::make_unique<FakeInput>(std::move(items), 2.0), config.buffers.lidar_packets, "test-run", {});
+  SweepProcessor processor(config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
+  trajroi::daemon::RunOptions options;
+  options.replay = corridor_run();
+  EXPECT_EQ(trajroi::daemon::run_pipeline(pipeline, processor, outlet, options, /*signals=*/false), 0);
+
+  const auto published = outlet.inner.messages(config.lcm.points);
+  ASSERT_GT(published.size(), 20u);
+  const auto last = decode<trajroi::status_t>(outlet.inner.messages(config.lcm.status).back());
+  EXPECT_EQ(last.ring_drops, 0);
+  // Every whole sweep published is late; the last one may be the partial one flushed at the end.
+  EXPECT_GE(counter(last, "sweeps.late"), static_cast<std::int64_t>(published.size()) - 1);
+  EXPECT_LE(counter(last, "sweeps.late"), static_cast<std::int64_t>(published.size()));
 }
 
 }  // namespace

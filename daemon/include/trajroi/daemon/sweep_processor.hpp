@@ -102,6 +102,11 @@ struct Sweep {
   // from set_input_arrival), and the processing time the wiring measured.
   std::int64_t last_packet_arrival_ns = 0;
   std::int64_t processing_ns = 0;
+  // Set by the wiring as it hands the sweep over: when the processing of the packet that
+  // closed it began, and when it went to the publisher (a late sweep's log line says where
+  // its time went).
+  std::int64_t closing_packet_start_ns = 0;
+  std::int64_t handed_over_ns = 0;
 
   void reserve(std::size_t points, std::size_t centres);
   void clear_points() noexcept;

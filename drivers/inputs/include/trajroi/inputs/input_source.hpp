@@ -64,8 +64,7 @@ class InputSource {
   // Waits at most `timeout` for the next item. Never throws once constructed.
   virtual Next next(InputItem& item, std::chrono::milliseconds timeout) = 0;
   // True when next() would return an item now without waiting (a paced recording's next item
-  // is due): the reader hands items over in batches and wakes its consumer once per batch. A
-  // live source says false: each datagram wakes the consumer.
+  // is due): the reader does not let an item wait for company then. A live source says false.
   [[nodiscard]] virtual bool ready() const noexcept { return false; }
   [[nodiscard]] virtual const Notice& notice() const noexcept = 0;
   [[nodiscard]] virtual const std::string& error() const noexcept = 0;
