@@ -6,9 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -91,7 +93,12 @@ class FakeInput final : public inputs::InputSource {
 
 class FakeOutlet final : public trajroi::daemon::Outlet {
  public:
+  FakeOutlet() = default;
+  // Takes `delay` to send each message on `slow_channel` (a slow network or subscriber).
+  FakeOutlet(std::string slow_channel, std::chrono::milliseconds delay)
+      : slow_channel_(std::move(slow_channel)), delay_(delay) {}
   void publish(const std::string& channel, std::span<const std::uint8_t> bytes) override {
+    if (channel == slow_channel_) std::this_thread::sleep_for(delay_);
     std::lock_guard<std::mutex> lock(mutex_);
     messages_[channel].emplace_back(bytes.begin(), bytes.end());
   }
@@ -104,6 +111,8 @@ class FakeOutlet final : public trajroi::daemon::Outlet {
   }
 
  private:
+  std::string slow_channel_;
+  std::chrono::milliseconds delay_{0};
   std::mutex mutex_;
   std::map<std::string, std::vector<std::vector<std::uint8_t>>> messages_;
 };
@@ -260,21 +269,7 @@ TEST(Pipeline, TheEvaluationKeepsExactlyWhatTheDaemonPublishes) {
 // sweep late, at the sensors' pace (the live path; an as-fast replay's queue is not lateness).
 TEST(Pipeline, LateSweepsAreCounted) {
   const DaemonConfig config = trajroi::daemon::load_daemon_config(corridor_run() / "trajroid.yaml");
-  class SlowOutlet final : public trajroi::daemon::Outlet {
-   public:
-    explicit SlowOutlet(std::string points) : points_(std::move(points)) {}
-    void publish(const std::string& channel, std::span<const std::uint8_t> bytes) override {
-      if (channel == points_) std::this_thread::sleep_for(std::chrono::milliseconds(6));
-      inner.publish(channel, bytes);
-    }
-    bool subscribe(const std::string&, Handler) override { return true; }
-    [[nodiscard]] int incoming_fd() const noexcept override { return -1; }
-    void handle_incoming() override {}
-    FakeOutlet inner;
-
-   private:
-    std::string points_;
-  } outlet(config.lcm.points);
+  FakeOutlet outlet(config.lcm.points, std::chrono::milliseconds(6));
   // The run's first 6 s at twice real time, in one paced lane.
   std::vector<Item> items = run_items({});
   const std::int64_t end_ns = items.front().t_ns + 6'000'000'000;
@@ -286,9 +281,9 @@ TEST(Pipeline, LateSweepsAreCounted) {
   options.replay = corridor_run();
   EXPECT_EQ(trajroi::daemon::run_pipeline(pipeline, processor, outlet, options, /*signals=*/false), 0);
 
-  const auto published = outlet.inner.messages(config.lcm.points);
+  const auto published = outlet.messages(config.lcm.points);
   ASSERT_GT(published.size(), 20u);
-  const auto last = decode<trajroi::status_t>(outlet.inner.messages(config.lcm.status).back());
+  const auto last = decode<trajroi::status_t>(outlet.messages(config.lcm.status).back());
   EXPECT_EQ(last.ring_drops, 0);
   // Every whole sweep published is late; the last one may be the partial one flushed at the end.
   EXPECT_GE(counter(last, "sweeps.late"), static_cast<std::int64_t>(published.size()) - 1);
