@@ -17,12 +17,20 @@ std::uint32_t missing(double observed, double expected) noexcept {
   return n < 1.0 ? 1u : n > 1e9 ? 1'000'000'000u : static_cast<std::uint32_t>(n);
 }
 
+// Any azimuth in degrees as [0, 360), exactly the same value when already there (a negative
+// one just below 0 gives 0, not 360).
+double wrapped_deg(double deg) noexcept {
+  double r = std::fmod(deg, 360.0);
+  if (r < 0.0) r += 360.0;
+  return r >= 360.0 ? 0.0 : r;
+}
+
 }  // namespace
 
 std::uint16_t cut_centidegrees(double cut_azimuth_deg) noexcept {
   if (!std::isfinite(cut_azimuth_deg)) return 0;
-  const double deg = std::fmod(std::fmod(cut_azimuth_deg, 360.0) + 360.0, 360.0);
-  return static_cast<std::uint16_t>(static_cast<std::uint32_t>(std::lround(deg * 100.0)) % kAzimuthLimit);
+  return static_cast<std::uint16_t>(static_cast<std::uint32_t>(std::lround(wrapped_deg(cut_azimuth_deg) * 100.0)) %
+                                    kAzimuthLimit);
 }
 
 bool may_complete_frame(std::span<const std::uint8_t> packet, std::uint16_t cut_cdeg) noexcept {
@@ -42,8 +50,7 @@ std::uint64_t StreamCounters::rejected_total() const noexcept {
 
 StreamDecoder::StreamDecoder(const Calibration& calibration, StreamOptions options)
     : decoder_(calibration, options.decode), options_(options) {
-  options_.cut_azimuth_deg = std::fmod(options_.cut_azimuth_deg, 360.0);
-  if (options_.cut_azimuth_deg < 0.0) options_.cut_azimuth_deg += 360.0;
+  options_.cut_azimuth_deg = wrapped_deg(options_.cut_azimuth_deg);
   held_.reserve(ModelCheck::kMaxUndecided);
   frame_.points.reserve(kFrameReserve);
   carried_.reserve(kBlocks * kFiringsPerBlock * kLasers);
