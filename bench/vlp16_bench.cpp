@@ -1,6 +1,7 @@
-// VLP-16 decode throughput over the MRPT capture's 293 data packets held in memory (single
-// thread). Goal (issue 3): at least 100 M points/s, > 300× a dual-return VLP-16's output.
-// The capture is found through TRAJROI_DATA_DIR (default: the build's data folder).
+// VLP-16 decode throughput over real captures held in memory (single thread): the MRPT
+// capture's 293 strongest-return data packets and nebula's dual-return capture. Goal (issue 3):
+// at least 100 M points/s, > 300× a dual-return VLP-16's output. The captures are found
+// through TRAJROI_DATA_DIR (default: the build's data folder).
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
@@ -21,28 +22,34 @@ struct Capture {
   std::vector<std::int64_t> times;
 };
 
+Capture load_capture(const char* relative) {
+  const char* dir = std::getenv("TRAJROI_DATA_DIR");
+  const std::filesystem::path path = std::filesystem::path(dir != nullptr ? dir : TRAJROI_DEFAULT_DATA_DIR) / relative;
+  Capture c;
+  PcapSource source(path);
+  Datagram d;
+  while (source.next(d) == PacketSource::Next::kDatagram) {
+    if (d.destination_port != kDataPort) continue;
+    c.packets.emplace_back(d.payload.begin(), d.payload.end());
+    c.times.push_back(d.receive_time_ns);
+  }
+  if (c.packets.empty()) throw std::runtime_error(path.string() + ": no data packets");
+  return c;
+}
+
 const Capture& mrpt_capture() {
-  static const Capture capture = [] {
-    const char* dir = std::getenv("TRAJROI_DATA_DIR");
-    const std::filesystem::path path = std::filesystem::path(dir != nullptr ? dir : TRAJROI_DEFAULT_DATA_DIR) /
-                                       "velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap";
-    Capture c;
-    PcapSource source(path);
-    Datagram d;
-    while (source.next(d) == PacketSource::Next::kDatagram) {
-      if (d.destination_port != kDataPort) continue;
-      c.packets.emplace_back(d.payload.begin(), d.payload.end());
-      c.times.push_back(d.receive_time_ns);
-    }
-    if (c.packets.empty()) throw std::runtime_error(path.string() + ": no data packets");
-    return c;
-  }();
+  static const Capture capture = load_capture("velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap");
+  return capture;
+}
+
+const Capture& dual_capture() {
+  static const Capture capture = load_capture("velodyne/vlp16/nebula_vlp16_dual_1673400471.DERIVED.pcap");
   return capture;
 }
 
 // PacketDecoder alone: bytes to points, output vector reused.
-void BM_DecodePackets(benchmark::State& state) {
-  const Capture& capture = mrpt_capture();
+void BM_DecodePackets(benchmark::State& state, const Capture& (*which)()) {
+  const Capture& capture = which();
   const PacketDecoder decoder(Calibration::vlp16_default());
   std::vector<Point> points;
   points.reserve(capture.packets.size() * 384);
@@ -59,7 +66,8 @@ void BM_DecodePackets(benchmark::State& state) {
       benchmark::Counter(static_cast<double>(capture.packets.size()) * static_cast<double>(state.iterations()),
                          benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_DecodePackets)->Name("vlp16/decode/mrpt")->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_DecodePackets, mrpt, mrpt_capture)->Name("vlp16/decode/mrpt")->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_DecodePackets, dual, dual_capture)->Name("vlp16/decode/dual")->Unit(benchmark::kMicrosecond);
 
 // The whole stream path: validation, model check, sequencing, decoding and frame assembly.
 struct CountingSink final : FrameSink {
@@ -67,8 +75,8 @@ struct CountingSink final : FrameSink {
   void on_frame(const Frame& frame) override { points += frame.points.size(); }
 };
 
-void BM_StreamDecoder(benchmark::State& state) {
-  const Capture& capture = mrpt_capture();
+void BM_StreamDecoder(benchmark::State& state, const Capture& (*which)()) {
+  const Capture& capture = which();
   std::size_t decoded = 0;
   for (auto _ : state) {
     state.PauseTiming();
@@ -82,7 +90,8 @@ void BM_StreamDecoder(benchmark::State& state) {
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(decoded));
 }
-BENCHMARK(BM_StreamDecoder)->Name("vlp16/stream/mrpt")->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_StreamDecoder, mrpt, mrpt_capture)->Name("vlp16/stream/mrpt")->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_StreamDecoder, dual, dual_capture)->Name("vlp16/stream/dual")->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

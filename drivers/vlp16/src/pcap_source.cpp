@@ -3,6 +3,9 @@
 #include <pcap/pcap.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <stdexcept>
 #include <utility>
 
@@ -19,6 +22,9 @@ constexpr std::uint16_t kEtherIpv4 = 0x0800;
 constexpr std::uint16_t kEtherVlan = 0x8100;
 constexpr std::uint16_t kEtherQinQ = 0x88A8;
 constexpr std::uint8_t kIpProtoUdp = 17;
+// The capture is read through a stdio buffer this large: with stdio's default 4 KiB, an
+// as-fast-as-possible replay of a 54 MB capture made 13 000 read() calls.
+constexpr std::size_t kReadBufferBytes = std::size_t{1} << 20;
 
 std::uint16_t be16(const std::uint8_t* p) {
   return static_cast<std::uint16_t>((p[0] << 8) | p[1]);
@@ -54,16 +60,25 @@ long ipv4_offset(int link, const std::uint8_t* frame, std::size_t length) {
 
 struct PcapSource::Handle {
   pcap_t* pcap = nullptr;
+  std::unique_ptr<char[]> buffer;  // the capture FILE's (glibc ignores a size without one)
   ~Handle() {
-    if (pcap != nullptr) pcap_close(pcap);
+    if (pcap != nullptr) pcap_close(pcap);  // closes the FILE, before the buffer goes
   }
 };
 
 PcapSource::PcapSource(const std::filesystem::path& path, PcapOptions options)
     : handle_(std::make_unique<Handle>()), options_(std::move(options)) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) {
+    const int error = errno;
+    throw std::runtime_error(path.string() + ": cannot open capture: " + std::strerror(error));
+  }
+  handle_->buffer = std::make_unique_for_overwrite<char[]>(kReadBufferBytes);
+  (void)std::setvbuf(file, handle_->buffer.get(), _IOFBF, kReadBufferBytes);  // the default buffer if refused
   char message[PCAP_ERRBUF_SIZE] = {};
-  handle_->pcap = pcap_open_offline_with_tstamp_precision(path.c_str(), PCAP_TSTAMP_PRECISION_NANO, message);
+  handle_->pcap = pcap_fopen_offline_with_tstamp_precision(file, PCAP_TSTAMP_PRECISION_NANO, message);
   if (handle_->pcap == nullptr) {
+    (void)std::fclose(file);  // pcap_close() closes it once the capture is open
     throw std::runtime_error(path.string() + ": cannot open capture: " + message);
   }
   link_type_ = pcap_datalink(handle_->pcap);
