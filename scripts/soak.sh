@@ -5,7 +5,10 @@
 # sweep → LCM publication), ring and kernel drops, as the daemon's own once-a-minute line
 # reports them, and the CPU time the hypervisor took from this machine (steal). Passes when
 # memory stays within 5 % of the first minute's and nothing is dropped; says how many minutes
-# had a maximum latency above 5 ms.
+# had a maximum latency above 5 ms. With cyclictest installed (Debian's rt-tests), it also runs
+# a witness of the machine itself: a SCHED_FIFO thread per CPU waking every millisecond, whose
+# longest delay each minute no process of this machine can have caused (nothing runs above it),
+# printed next to the daemon's.
 # Usage: scripts/soak.sh [MINUTES=10] [RATE=10] [BUILD_DIR=build/release]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -18,8 +21,13 @@ if [ ! -x "$build/daemon/trajroid" ] || [ ! -x "$build/tools/trajroi" ]; then
 fi
 work=$(mktemp -d)
 daemon_pid=
+probe_pid=
 cleanup() {
   if [ -n "$daemon_pid" ]; then kill "$daemon_pid" 2>/dev/null || true; fi
+  if [ -n "$probe_pid" ]; then
+    children=$(pgrep -P "$probe_pid" || true)
+    kill "$probe_pid" $children 2>/dev/null || true
+  fi
   rm -rf "$work"
 }
 trap cleanup EXIT
@@ -33,6 +41,17 @@ printf 'lcm:\n  channels: {points: SOAK_POINTS, pose: SOAK_POSE, roi: SOAK_ROI, 
 "$build/daemon/trajroid" --config "$work/run/soak.yaml" --replay "$work/run" --loop --rate "$rate" \
   --lcm-url 'udpm://239.255.76.67:7667?ttl=0' 2>"$work/trajroid.log" &
 daemon_pid=$!
+probe=$(command -v cyclictest || true)
+if [ -n "$probe" ]; then
+  # One run a minute, started with the daemon: its m-th line is the daemon's m-th minute (ms).
+  for ((m = 1; m <= minutes; ++m)); do
+    "$probe" -q -m -S -p 90 -i 1000 -D 60 2>/dev/null |
+      awk '/Max:/ {v = $NF + 0; if (v > max) max = v} END {printf "%.2f\n", max / 1000}'
+  done >"$work/probe.txt" &
+  probe_pid=$!
+else
+  echo "soak: cyclictest not installed (apt-get install rt-tests): no witness of the machine's own wake-up delays"
+fi
 echo "soak: corridor run (${lap_s} s of dual-return data a lap) looped at ${rate}x real time for ${minutes} min"
 echo "soak: machine: $(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1), $(nproc) cores"
 printf '%-6s %9s %8s %9s %10s %10s %10s %10s %10s %10s\n' minute "RSS MiB" sweeps published "p50 ms" "p99 ms" "max ms" \
@@ -88,6 +107,13 @@ awk -v all="${maxima[*]}" 'BEGIN {
   for (i = 1; i <= n; ++i) { if (v[i] > 5) ++over; if (v[i] > hi) hi = v[i] }
   printf "soak: per-minute maximum latency up to %.2f ms; %d of %d minutes above 5 ms (goal 0)\n", hi, over, n
 }'
+if [ -n "$probe_pid" ]; then
+  wait "$probe_pid" || true
+  probe_pid=
+  echo "soak: per-minute maximum, daemon's latency / the machine's wake-up delay (cyclictest, SCHED_FIFO, every CPU each ms):"
+  paste -d ' ' <(printf '%s\n' "${maxima[@]}") "$work/probe.txt" |
+    awk '{printf "  minute %d: %s / %s ms\n", NR, $1, ($2 == "" ? "-" : $2)}'
+fi
 drops=$(grep ' minute: ' "$work/trajroid.log" | head -n "$seen" |
   awk '{for (i = 1; i <= NF; ++i) {if ($i == "ring") r += $(i + 2); if ($i == "kernel") k += $(i + 2)}} END {print r + k}')
 awk -v first="${rss[0]}" -v last="${rss[${#rss[@]} - 1]}" -v drops="$drops" -v all="${rss[*]}" 'BEGIN {

@@ -5,11 +5,15 @@
 #include "pipeline.hpp"
 
 #include <gtest/gtest.h>
+#include <spdlog/sinks/ringbuffer_sink.h>
+#include <spdlog/spdlog.h>
 
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <mutex>
+#include <regex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -279,7 +283,12 @@ TEST(Pipeline, LateSweepsAreCounted) {
   SweepProcessor processor(config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
   trajroi::daemon::RunOptions options;
   options.replay = corridor_run();
+  // The daemon's log lines, kept for reading back.
+  auto lines = std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(256);
+  auto& sinks = spdlog::default_logger()->sinks();
+  sinks.push_back(lines);
   EXPECT_EQ(trajroi::daemon::run_pipeline(pipeline, processor, outlet, options, /*signals=*/false), 0);
+  sinks.pop_back();
 
   const auto published = outlet.messages(config.lcm.points);
   ASSERT_GT(published.size(), 20u);
@@ -288,6 +297,25 @@ TEST(Pipeline, LateSweepsAreCounted) {
   // Every whole sweep published is late; the last one may be the partial one flushed at the end.
   EXPECT_GE(counter(last, "sweeps.late"), static_cast<std::int64_t>(published.size()) - 1);
   EXPECT_LE(counter(last, "sweeps.late"), static_cast<std::int64_t>(published.size()));
+
+  // A late sweep is described (once per warning interval): its latency split into five steps
+  // that add up to it, the outlet's 6 ms in the sending.
+  const std::regex late_line(
+      R"(sweep \d+ late: ([0-9.]+) ms from its last packet to LCM \(waiting for the processing thread ([0-9.]+), the )"
+      R"(closing packet and hand-over ([0-9.]+), waiting for the publisher ([0-9.]+), encoding ([0-9.]+), sending )"
+      R"(([0-9.]+) ms\); \d+ late sweeps \(over 5 ms\) so far)");
+  int described = 0;
+  for (const std::string& line : lines->last_formatted()) {
+    std::smatch m;
+    if (!std::regex_search(line, m, late_line)) continue;
+    ++described;
+    double steps = 0.0;
+    for (std::size_t i = 2; i <= 6; ++i)
+      steps += std::stod(m[i].str());
+    EXPECT_NEAR(std::stod(m[1].str()), steps, 0.03) << line;  // five roundings of 0.005
+    EXPECT_GE(std::stod(m[6].str()), 6.0) << line;
+  }
+  EXPECT_GE(described, 1);
 }
 
 }  // namespace
