@@ -112,7 +112,8 @@ if [ -n "$probe_pid" ]; then
   probe_pid=
   echo "soak: per-minute maximum, daemon's latency / the machine's wake-up delay (cyclictest, SCHED_FIFO, every CPU each ms):"
   paste -d ' ' <(printf '%s\n' "${maxima[@]}") "$work/probe.txt" |
-    awk '{printf "  minute %d: %s / %s ms\n", NR, $1, ($2 == "" ? "-" : $2)}'
+    awk '{printf "  minute %d: %s / %s ms\n", NR, $1, ($2 == "" ? "-" : $2)}
+      $2 > 5 {++slow} END {if (slow > 0) printf "soak: the machine itself held a thread off for over 5 ms in %d of %d minutes: a 5 ms maximum cannot be judged here\n", slow, NR}'
 fi
 drops=$(grep ' minute: ' "$work/trajroid.log" | head -n "$seen" |
   awk '{for (i = 1; i <= NF; ++i) {if ($i == "ring") r += $(i + 2); if ($i == "kernel") k += $(i + 2)}} END {print r + k}')
