@@ -25,8 +25,9 @@ probe_pid=
 cleanup() {
   if [ -n "$daemon_pid" ]; then kill "$daemon_pid" 2>/dev/null || true; fi
   if [ -n "$probe_pid" ]; then
-    children=$(pgrep -P "$probe_pid" || true)
-    kill "$probe_pid" $children 2>/dev/null || true
+    local -a children
+    mapfile -t children < <(pgrep -P "$probe_pid" || true)
+    kill "$probe_pid" "${children[@]}" 2>/dev/null || true
   fi
   rm -rf "$work"
 }
