@@ -245,6 +245,13 @@ void Publisher::log_minute(const StatusSnapshot& s) {
   minute_start_ = s;
 }
 
+void Publisher::publish_pending_sweeps() {
+  while (Sweep* s = pipeline_.sweeps.front()) {
+    publish_sweep(*s);
+    pipeline_.sweeps.release();
+  }
+}
+
 void Publisher::run() {
   if (const std::string w = apply_thread_config("trajroid-pub", config_.realtime.publisher); !w.empty()) {
     log::warn("{}", w);
@@ -262,11 +269,12 @@ void Publisher::run() {
       if ((fds[0].revents & POLLIN) != 0) outlet_.handle_incoming();
       if ((fds[1].revents & POLLIN) != 0) pipeline_.publish_wake.drain();
     }
-    while (Sweep* s = pipeline_.sweeps.front()) {
-      publish_sweep(*s);
-      pipeline_.sweeps.release();
-    }
+    publish_pending_sweeps();
     while (StatusSnapshot* s = pipeline_.status->front()) {
+      // The sweeps handed over before this snapshot go out first, so that a status (the final
+      // one above all) counts every sweep it says was published: the processing thread may
+      // have queued a sweep and then the snapshot since the loop above emptied the ring.
+      publish_pending_sweeps();
       publish_status(*s);
       final_seen = final_seen || s->final;
       pipeline_.status->release();

@@ -37,6 +37,8 @@ class Publisher {
   void on_trajectory_message(std::span<const std::uint8_t> bytes, const std::string& channel);
   void offer(std::unique_ptr<ActiveTrajectory> trajectory);
   void publish_sweep(const Sweep& s);
+  // Every sweep in the ring, oldest first.
+  void publish_pending_sweeps();
   // A sweep later than kLateSweep_ms from its last packet to LCM: where the time went, said at
   // most once per logging.warning_interval_s (not at --rate max, where the queue is the design).
   void report_late(const Sweep& s, std::int64_t dequeued_ns, std::int64_t encoded_ns, std::int64_t sent_ns);
