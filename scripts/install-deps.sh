@@ -13,6 +13,8 @@ packages=(
   liblcm-dev liblcm-bin liblcm-java libjchart2d-java default-jdk-headless
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  # the soak's witness of the machine's own wake-up delays (cyclictest)
+  rt-tests
   # fuzzing and sanitizers (clang's libFuzzer and runtimes); the clang build and the format check
   clang libclang-rt-14-dev clang-format
   # systemd-analyze for the unit checks; the service tests boot systemd in namespaces

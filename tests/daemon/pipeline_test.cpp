@@ -313,11 +313,11 @@ TEST(Pipeline, LateSweepsAreCounted) {
     ++described;
     std::vector<double> figures;
     std::size_t at = 0;
-    for (std::size_t i = 0; i < labels.size(); ++i) {
+    for (const std::string& label : labels) {
       // Each label follows the previous figure (the first one's is the sweep index before it).
-      const std::size_t found = line.find(labels[i], at);
-      ASSERT_NE(found, std::string::npos) << "no '" << labels[i] << "' in: " << line;
-      at = found + labels[i].size();
+      const std::size_t found = line.find(label, at);
+      ASSERT_NE(found, std::string::npos) << "no '" << label << "' in: " << line;
+      at = found + label.size();
       std::size_t used = 0;
       figures.push_back(std::stod(line.substr(at), &used));
       at += used;
