@@ -212,6 +212,30 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   bool have_phase = have_phase_;
   bool counted = false;
   while (i < points.size()) {
+    // Most points neither begin a frame nor cross the cut or the longest frame: those are
+    // placed here with the frame's fields in locals; the point that ends this loop early
+    // goes through the general step below (the same arithmetic, so the same result).
+    if (i > 0 && have_phase) {
+      Point* const p = points.data();
+      const std::size_t n = points.size();
+      const std::int64_t start_ns = frame_.start_time_ns;
+      const double cut_deg = options_.cut_azimuth_deg;
+      const std::size_t from = i;
+      for (; i < n; ++i) {
+        double phase = static_cast<double>(p[i].azimuth_deg) - cut_deg;
+        if (phase < 0.0) phase += 360.0;
+        const std::int64_t t = time_ns + p[i].time_offset_ns;
+        if (phase < last_phase_deg - 180.0 || t - start_ns > kMaxFrameDuration_ns) break;
+        last_phase_deg = phase;
+        p[i].time_offset_ns = static_cast<std::uint32_t>(t - start_ns);
+        end_time_ns = std::max(end_time_ns, t);
+      }
+      if (i > from && !counted) {
+        ++frame_.packets;
+        counted = true;
+      }
+      if (i == n) break;
+    }
     double phase = static_cast<double>(points[i].azimuth_deg) - options_.cut_azimuth_deg;
     if (phase < 0.0) phase += 360.0;
     const std::int64_t t = time_ns + points[i].time_offset_ns;
