@@ -110,6 +110,44 @@ TEST(Vlp16Stream, CleanStreamGivesWholeSweepsCutAtTheConfiguredAzimuth) {
   }
 }
 
+// A sensor whose head stops turning (azimuth stuck) never reaches the cut: its points are
+// cut into partial frames of at most kMaxFrameDuration_ns (2 s), none lost, each point's time
+// after its own frame's start.
+TEST(Vlp16Stream, ASensorThatStopsTurningIsCutIntoFramesOfAtMostTwoSeconds) {
+  Sensor stuck;
+  stuck.step_cdeg = 0;
+  constexpr std::size_t kPackets = 3768;  // 5.0 s of packets 1327.104 µs apart
+  const Outcome r = run(stuck, kPackets);
+  EXPECT_EQ(r.counters.decoded_packets, kPackets);
+  EXPECT_EQ(r.counters.lost_packets, 0u);
+  ASSERT_EQ(r.sink.frames.size(), 3u);  // 0–2 s, 2–4 s, 4–5 s
+  std::size_t points = 0;
+  std::uint32_t packets = 0;
+  for (std::size_t i = 0; i < r.sink.frames.size(); ++i) {
+    const Frame& f = r.sink.frames[i];
+    EXPECT_TRUE(f.partial) << i;
+    EXPECT_EQ(f.index, i);
+    points += f.points.size();
+    packets += f.packets;
+    EXPECT_LE(f.end_time_ns - f.start_time_ns, kMaxFrameDuration_ns) << i;
+    EXPECT_EQ(f.points.front().time_offset_ns, 0u) << i;
+    EXPECT_EQ(static_cast<std::int64_t>(f.points.back().time_offset_ns), f.end_time_ns - f.start_time_ns) << i;
+    for (std::size_t k = 1; k < f.points.size(); ++k)
+      ASSERT_GE(f.points[k].time_offset_ns, f.points[k - 1].time_offset_ns) << i << " " << k;
+    if (i + 1 < r.sink.frames.size()) {
+      // The next frame begins with the first point past 2 s (points are at most one block,
+      // 110.592 µs, apart) and right after this one's last point.
+      const Frame& next = r.sink.frames[i + 1];
+      EXPECT_GT(next.start_time_ns - f.start_time_ns, kMaxFrameDuration_ns) << i;
+      EXPECT_LE(next.start_time_ns - f.start_time_ns, kMaxFrameDuration_ns + 110'592) << i;
+      EXPECT_GT(next.start_time_ns, f.end_time_ns) << i;
+      EXPECT_LE(next.start_time_ns - f.end_time_ns, 110'592) << i;
+    }
+  }
+  EXPECT_EQ(points, kPackets * 384);  // every channel of every packet returns
+  EXPECT_EQ(packets, kPackets);       // a packet split by a cut counts in the frame of its first firing
+}
+
 TEST(Vlp16Stream, MissingPacketsAreCountedInTheirFrame) {
   const Outcome r = run(Sensor{}, 3 * kPacketsPerTurn, {}, [](std::size_t i, auto&) { return i < 100 || i > 102; });
   EXPECT_EQ(r.counters.lost_packets, 3u);
