@@ -3,7 +3,8 @@
 # (tests/daemon/corridor.yaml, 28.8 s) replayed through the daemon publishing over LCM on
 # loopback, (1) at real-time pace: latency from the last packet of a sweep to its LCM
 # publication (p50, p99), CPU time per second of data, ring drops; (2) as fast as possible:
-# the replay speed as a multiple of real time.
+# the replay speed as a multiple of real time. Each kind is run TRAJROI_FIGURE_RUNS times (5)
+# and its medians are the figures.
 # Usage: bench/daemon_figures.sh [BUILD_DIR]   (default build/release)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -46,5 +47,9 @@ echo "real-time replay, ${runs} runs: latency last packet → LCM p50 ${p50} ms,
 awk -v c="$cpu" -v p="$pipeline" -v d="$duration" 'BEGIN {
   printf "real-time replay: CPU of the pipeline (processing + publishing threads) %.3f s for %.1f s of data = %.2f %% of one core (median; goal <= 2 %%)\n", p, d, 100 * p / d
   printf "real-time replay: CPU of the whole process, the replay reader standing in for the sensors included, %.3f s = %.2f %%\n", c, 100 * c / d}'
-read -r _ _ drops wall _ _ < <(figures max)
-awk -v w="$wall" -v d="$duration" -v x="$drops" 'BEGIN {printf "as fast as possible: %.1f s of data in %.2f s = %.0fx real time (goal >= 200x); ring drops %d\n", d, w, d / w, x}'
+# As fast as possible, as many runs: the median wall time (one run's is one spell of the host).
+fast=$(for _ in $(seq 1 "$runs"); do figures max; done)
+wall=$(awk '{print $4}' <<<"$fast" | median)
+drops=$(awk '{s += $3} END {print s}' <<<"$fast")
+awk -v w="$wall" -v d="$duration" -v x="$drops" -v n="$runs" -v each="$(awk '{printf "%s ", $4}' <<<"$fast")" \
+  'BEGIN {printf "as fast as possible, %d runs: %.1f s of data in %.2f s = %.0fx real time (median; goal >= 200x; each run: %ss); ring drops %d\n", n, d, w, d / w, each, x}'
