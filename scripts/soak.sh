@@ -100,7 +100,7 @@ kill -TERM "$daemon_pid"
 wait "$daemon_pid" || true
 daemon_pid=
 summary=$(grep 'summary:' "$work/trajroid.log" || true)
-echo "soak: $(sed 's/.*summary: //' <<<"$summary")"
+echo "soak: ${summary#*summary: }"
 laps=$(grep -c 'replay: lap' "$work/trajroid.log" || true)
 echo "soak: $((laps + 1)) laps; lidar restarts at each lap boundary are the replay looping, not a fault"
 awk -v all="${maxima[*]}" 'BEGIN {
@@ -108,6 +108,9 @@ awk -v all="${maxima[*]}" 'BEGIN {
   for (i = 1; i <= n; ++i) { if (v[i] > 5) ++over; if (v[i] > hi) hi = v[i] }
   printf "soak: per-minute maximum latency up to %.2f ms; %d of %d minutes above 5 ms (goal 0)\n", hi, over, n
 }'
+# Where each late minute's slowest sweep spent its time (the daemon names it on the minute's line).
+grep ' minute: ' "$work/trajroid.log" | head -n "$seen" |
+  awk -F ' [|] slowest: ' 'NF > 1 {printf "soak: minute %d, slowest: %s\n", NR, $2}'
 if [ -n "$probe_pid" ]; then
   wait "$probe_pid" || true
   probe_pid=

@@ -1,6 +1,7 @@
 #include "publisher.hpp"
 
 #include <poll.h>
+#include <spdlog/fmt/fmt.h>
 #include <systemd/sd-daemon.h>
 #include <unistd.h>
 
@@ -116,19 +117,20 @@ void Publisher::take_reloads() {
   }
 }
 
-void Publisher::report_late(const Sweep& s, std::int64_t dequeued_ns, std::int64_t encoded_ns, std::int64_t sent_ns) {
+std::string Publisher::SweepTiming::describe() const {
+  return fmt::format(
+      "{:.2f} ms from its last packet to LCM (waiting for the processing thread {:.2f}, the closing packet and "
+      "hand-over {:.2f}, waiting for the publisher {:.2f}, encoding {:.2f}, sending {:.2f} ms)",
+      total_ms, processing_wait_ms, closing_ms, publisher_wait_ms, encoding_ms, sending_ms);
+}
+
+void Publisher::report_late(const SweepTiming& t, std::int64_t sent_ns) {
   ++late_sweeps_;
   std::uint64_t suppressed = 0;
   if (!late_limit_.allow(sent_ns, suppressed)) return;
-  const auto ms = [](std::int64_t from, std::int64_t to) { return static_cast<double>(to - from) * 1e-6; };
-  log::info(
-      "sweep {} late: {:.2f} ms from its last packet to LCM (waiting for the processing thread {:.2f}, the closing "
-      "packet and hand-over {:.2f}, waiting for the publisher {:.2f}, encoding {:.2f}, sending {:.2f} ms); {} late "
-      "sweeps (over {:.0f} ms) so far{}",
-      s.index, ms(s.last_packet_arrival_ns, sent_ns), ms(s.last_packet_arrival_ns, s.closing_packet_start_ns),
-      ms(s.closing_packet_start_ns, s.handed_over_ns), ms(s.handed_over_ns, dequeued_ns), ms(dequeued_ns, encoded_ns),
-      ms(encoded_ns, sent_ns), late_sweeps_, kLateSweep_ms,
-      suppressed > 0 ? " (" + std::to_string(suppressed) + " late sweeps not described)" : std::string());
+  log::info("sweep {} late: {}; {} late sweeps (over {:.0f} ms) so far{}", t.index, t.describe(), late_sweeps_,
+            kLateSweep_ms,
+            suppressed > 0 ? " (" + std::to_string(suppressed) + " late sweeps not described)" : std::string());
 }
 
 void Publisher::publish_sweep(const Sweep& s) {
@@ -145,8 +147,17 @@ void Publisher::publish_sweep(const Sweep& s) {
     // not the pipeline's: left out of the figures.
     if (!s.partial) {
       const std::int64_t sent_ns = steady_ns();
-      const double latency_ms = static_cast<double>(sent_ns - s.last_packet_arrival_ns) * 1e-6;
-      if (latency_ms > kLateSweep_ms && !pipeline_.exact) report_late(s, dequeued_ns, encoded_ns, sent_ns);
+      const auto ms = [](std::int64_t from, std::int64_t to) { return static_cast<double>(to - from) * 1e-6; };
+      const SweepTiming timing{.index = s.index,
+                               .total_ms = ms(s.last_packet_arrival_ns, sent_ns),
+                               .processing_wait_ms = ms(s.last_packet_arrival_ns, s.closing_packet_start_ns),
+                               .closing_ms = ms(s.closing_packet_start_ns, s.handed_over_ns),
+                               .publisher_wait_ms = ms(s.handed_over_ns, dequeued_ns),
+                               .encoding_ms = ms(dequeued_ns, encoded_ns),
+                               .sending_ms = ms(encoded_ns, sent_ns)};
+      const double latency_ms = timing.total_ms;
+      if (latency_ms > slowest_in_minute_.total_ms) slowest_in_minute_ = timing;
+      if (latency_ms > kLateSweep_ms && !pipeline_.exact) report_late(timing, sent_ns);
       if (latency_window_ms_.size() < latency_window_ms_.capacity()) latency_window_ms_.push_back(latency_ms);
       if (latency_minute_ms_.size() < latency_minute_ms_.capacity()) latency_minute_ms_.push_back(latency_ms);
       latency_all_.add(latency_ms);
@@ -231,17 +242,23 @@ void Publisher::publish_status(const StatusSnapshot& s) {
 
 // Once a minute, for the journal and soak tests: what the last minute did, and the memory.
 void Publisher::log_minute(const StatusSnapshot& s) {
+  // A late maximum says where its time went (an as-fast replay's queue is not lateness).
+  const std::string slowest =
+      slowest_in_minute_.total_ms > kLateSweep_ms && !pipeline_.exact
+          ? fmt::format(" | slowest: sweep {} {}", slowest_in_minute_.index, slowest_in_minute_.describe())
+          : std::string();
   log::info(
       "minute: {:.0f} s | sweeps {} published {} | latency p50 {:.2f} p99 {:.2f} max {:.2f} ms | ring drops {} | "
-      "kernel drops {} | lost packets {} | RSS {:.1f} MiB",
+      "kernel drops {} | lost packets {} | RSS {:.1f} MiB{}",
       static_cast<double>(s.steady_ns - minute_start_.steady_ns) * 1e-9,
       s.processor.sweeps - minute_start_.processor.sweeps,
       s.processor.sweeps_filtered - minute_start_.processor.sweeps_filtered, percentile(latency_minute_ms_, 0.50),
       percentile(latency_minute_ms_, 0.99), percentile(latency_minute_ms_, 1.0),
       s.ring_drops() - minute_start_.ring_drops(),
       s[Counter::kLidarKernelDrops] - minute_start_[Counter::kLidarKernelDrops],
-      s.lost_packets - minute_start_.lost_packets, rss_mib());
+      s.lost_packets - minute_start_.lost_packets, rss_mib(), slowest);
   latency_minute_ms_.clear();
+  slowest_in_minute_ = SweepTiming{.total_ms = -1.0};
   minute_start_ = s;
 }
 

@@ -41,7 +41,18 @@ class Publisher {
   void publish_pending_sweeps();
   // A sweep later than kLateSweep_ms from its last packet to LCM: where the time went, said at
   // most once per logging.warning_interval_s (not at --rate max, where the queue is the design).
-  void report_late(const Sweep& s, std::int64_t dequeued_ns, std::int64_t encoded_ns, std::int64_t sent_ns);
+  // Where a sweep's time went, from its last packet's arrival to its points sent.
+  struct SweepTiming {
+    std::uint64_t index = 0;
+    double total_ms = 0.0;
+    double processing_wait_ms = 0.0;  // waiting for the processing thread to take the closing packet
+    double closing_ms = 0.0;          // the closing packet and the hand-over
+    double publisher_wait_ms = 0.0;   // waiting in the ring for the publisher
+    double encoding_ms = 0.0, sending_ms = 0.0;
+    // "12.30 ms from its last packet to LCM (waiting for the processing thread …, sending … ms)"
+    [[nodiscard]] std::string describe() const;
+  };
+  void report_late(const SweepTiming& t, std::int64_t sent_ns);
   void publish_status(const StatusSnapshot& s);
   void log_minute(const StatusSnapshot& s);
   void take_reloads();
@@ -73,6 +84,9 @@ class Publisher {
   log::RateLimited trajectory_warn_limit_;  // rejected trajectory messages: never hidden by the above
   log::RateLimited late_limit_;             // late sweeps
   std::uint64_t late_sweeps_ = 0;
+  // The current minute's slowest sweep (total_ms < 0: none yet), named with the minute's line
+  // when late: one per minute, whatever the warning interval let through.
+  SweepTiming slowest_in_minute_{.total_ms = -1.0};
 };
 
 }  // namespace trajroi::daemon

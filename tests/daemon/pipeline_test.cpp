@@ -298,36 +298,66 @@ TEST(Pipeline, LateSweepsAreCounted) {
   EXPECT_LE(counter(last, "sweeps.late"), static_cast<std::int64_t>(published.size()));
 
   // A late sweep is described (once per warning interval): its latency split into five steps
-  // that add up to it, the outlet's 6 ms in the sending.
-  // The figure after each label, in the line's order.
-  const std::vector<std::string> labels = {" late: ",
-                                           " ms from its last packet to LCM (waiting for the processing thread ",
-                                           ", the closing packet and hand-over ",
-                                           ", waiting for the publisher ",
-                                           ", encoding ",
-                                           ", sending "};
-  int described = 0;
-  for (const std::string& line : lines->last_formatted()) {
-    if (line.find(" late: ") == std::string::npos || line.find("late sweeps (over 5 ms) so far") == std::string::npos)
-      continue;
-    ++described;
+  // that add up to it, the outlet's 6 ms in the sending. So is each minute's slowest sweep, on
+  // the minute's line (here the final one).
+  // The total after `first_label` (and after the sweep's index that follows it, when
+  // `index_first`) and the figure after each step's label, in the line's order; empty when the
+  // line has no `first_label`.
+  const auto timing = [](const std::string& line, const std::string& first_label, bool index_first) {
+    const std::vector<std::string> labels = {first_label,
+                                             " ms from its last packet to LCM (waiting for the processing thread ",
+                                             ", the closing packet and hand-over ",
+                                             ", waiting for the publisher ",
+                                             ", encoding ",
+                                             ", sending "};
     std::vector<double> figures;
     std::size_t at = 0;
     for (const std::string& label : labels) {
       // Each label follows the previous figure (the first one's is the sweep index before it).
       const std::size_t found = line.find(label, at);
-      ASSERT_NE(found, std::string::npos) << "no '" << label << "' in: " << line;
+      if (found == std::string::npos) {
+        EXPECT_TRUE(figures.empty()) << "no '" << label << "' in: " << line;
+        return std::vector<double>{};
+      }
       at = found + label.size();
+      if (index_first && figures.empty()) {
+        std::size_t digits = 0;
+        (void)std::stoul(line.substr(at), &digits);
+        at += digits;
+        EXPECT_EQ(line[at], ' ') << line;
+      }
       std::size_t used = 0;
       figures.push_back(std::stod(line.substr(at), &used));
       at += used;
     }
-    ASSERT_EQ(line.compare(at, 4, " ms)"), 0) << line;
+    EXPECT_EQ(line.compare(at, 4, " ms)"), 0) << line;
     const double steps = figures[1] + figures[2] + figures[3] + figures[4] + figures[5];
     EXPECT_NEAR(figures[0], steps, 0.031) << line;  // six figures, each rounded to 0.01
     EXPECT_GE(figures[5], 6.0) << line;
+    return figures;
+  };
+  int described = 0;
+  double latest_described_ms = 0.0;
+  std::vector<double> slowest;
+  for (const std::string& line : lines->last_formatted()) {
+    if (line.find(" minute: ") != std::string::npos) {
+      // The minute's maximum is its slowest sweep's total (each rounded to 0.01).
+      slowest = timing(line, " | slowest: sweep ", true);
+      ASSERT_FALSE(slowest.empty()) << line;
+      const std::size_t max_at = line.find(" max ");
+      ASSERT_NE(max_at, std::string::npos) << line;
+      EXPECT_NEAR(std::stod(line.substr(max_at + 5)), slowest[0], 0.011) << line;
+      continue;
+    }
+    if (line.find("late sweeps (over 5 ms) so far") == std::string::npos) continue;
+    const std::vector<double> late = timing(line, " late: ", false);
+    ASSERT_FALSE(late.empty()) << line;
+    ++described;
+    latest_described_ms = late[0];
   }
   EXPECT_GE(described, 1);
+  ASSERT_FALSE(slowest.empty());
+  EXPECT_GE(slowest[0], latest_described_ms - 0.011);  // none described was slower than the slowest
 }
 
 }  // namespace
