@@ -39,8 +39,6 @@ class Publisher {
   void publish_sweep(const Sweep& s);
   // Every sweep in the ring, oldest first.
   void publish_pending_sweeps();
-  // A sweep later than kLateSweep_ms from its last packet to LCM: where the time went, said at
-  // most once per logging.warning_interval_s (not at --rate max, where the queue is the design).
   // Where a sweep's time went, from its last packet's arrival to its points sent.
   struct SweepTiming {
     std::uint64_t index = 0;
@@ -52,6 +50,8 @@ class Publisher {
     // "12.30 ms from its last packet to LCM (waiting for the processing thread …, sending … ms)"
     [[nodiscard]] std::string describe() const;
   };
+  // A sweep later than kLateSweep_ms from its last packet to LCM: where the time went, said at
+  // most once per logging.warning_interval_s (not at --rate max, where the queue is the design).
   void report_late(const SweepTiming& t, std::int64_t sent_ns);
   void publish_status(const StatusSnapshot& s);
   void log_minute(const StatusSnapshot& s);
