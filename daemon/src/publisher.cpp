@@ -258,7 +258,7 @@ void Publisher::log_minute(const StatusSnapshot& s) {
       s[Counter::kLidarKernelDrops] - minute_start_[Counter::kLidarKernelDrops],
       s.lost_packets - minute_start_.lost_packets, rss_mib(), slowest);
   latency_minute_ms_.clear();
-  slowest_in_minute_ = SweepTiming{.total_ms = -1.0};
+  slowest_in_minute_ = {};
   minute_start_ = s;
 }
 

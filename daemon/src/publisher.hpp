@@ -42,7 +42,7 @@ class Publisher {
   // Where a sweep's time went, from its last packet's arrival to its points sent.
   struct SweepTiming {
     std::uint64_t index = 0;
-    double total_ms = 0.0;
+    double total_ms = -1.0;           // < 0: no sweep yet
     double processing_wait_ms = 0.0;  // waiting for the processing thread to take the closing packet
     double closing_ms = 0.0;          // the closing packet and the hand-over
     double publisher_wait_ms = 0.0;   // waiting in the ring for the publisher
@@ -84,9 +84,9 @@ class Publisher {
   log::RateLimited trajectory_warn_limit_;  // rejected trajectory messages: never hidden by the above
   log::RateLimited late_limit_;             // late sweeps
   std::uint64_t late_sweeps_ = 0;
-  // The current minute's slowest sweep (total_ms < 0: none yet), named with the minute's line
-  // when late: one per minute, whatever the warning interval let through.
-  SweepTiming slowest_in_minute_{.total_ms = -1.0};
+  // The current minute's slowest sweep, named with the minute's line when late: one per
+  // minute, whatever the warning interval let through.
+  SweepTiming slowest_in_minute_;
 };
 
 }  // namespace trajroi::daemon
