@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <array>
+#include <cstddef>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
 
 #include "trajroi/config/text_file.hpp"
 #include "trajroi/framing/little_endian.hpp"
@@ -39,6 +43,72 @@ vlp16::StreamOptions stream_options(const DaemonConfig& c) {
 
 double size_along(const DaemonConfig::Roi& r) {
   return r.shape == RoiShape::kCircular ? r.circle_diameter_m : r.rect_height_m;
+}
+
+// The decoder's points as the filter takes them (x, y, z, intensity), in the sensor's frame.
+void copy_for_filter(std::span<const vlp16::Point> in, roi::PointXYZI* out) noexcept {
+  for (const vlp16::Point& p : in)
+    *out++ = roi::PointXYZI{p.x, p.y, p.z, static_cast<float>(p.intensity)};
+}
+
+#if defined(__x86_64__) || defined(__i386__)
+// Row i of global_from_sensor applied to four points: ((r_i0 x + r_i1 y) + r_i2 z) + t_i.
+__attribute__((target("avx"))) inline __m128 transformed_row(const Eigen::Isometry3d& global_from_sensor,
+                                                             Eigen::Index i, __m256d x, __m256d y, __m256d z) noexcept {
+  const Eigen::Matrix3d& r = global_from_sensor.linear();
+  const __m256d sum =
+      _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(r(i, 0)), x), _mm256_mul_pd(_mm256_set1_pd(r(i, 1)), y));
+  return _mm256_cvtpd_ps(_mm256_add_pd(_mm256_add_pd(sum, _mm256_mul_pd(_mm256_set1_pd(r(i, 2)), z)),
+                                       _mm256_set1_pd(global_from_sensor.translation()(i))));
+}
+
+// copy_for_filter then roi::transform_points in one pass, four points at a time: their x, y
+// and z side by side (a transpose of the records), each coordinate's products and sums in
+// transform_points' order, in doubles, without fused multiply-adds (none in this target), so
+// every coordinate rounds exactly as there.
+__attribute__((target("avx"))) void place_avx(const Eigen::Isometry3d& global_from_sensor,
+                                              std::span<const vlp16::Point> in, roi::PointXYZI* out) noexcept {
+  static_assert(offsetof(vlp16::Point, x) == 0 && offsetof(vlp16::Point, y) == 4 && offsetof(vlp16::Point, z) == 8 &&
+                sizeof(vlp16::Point) >= 16);
+  std::size_t i = 0;
+  for (; i + 4 <= in.size(); i += 4, out += 4) {
+    const vlp16::Point* p = &in[i];
+    __m128 a = _mm_loadu_ps(&p[0].x);  // x y z distance
+    __m128 b = _mm_loadu_ps(&p[1].x);
+    __m128 c = _mm_loadu_ps(&p[2].x);
+    __m128 d = _mm_loadu_ps(&p[3].x);
+    _MM_TRANSPOSE4_PS(a, b, c, d);  // a: four x, b: four y, c: four z
+    const __m256d x = _mm256_cvtps_pd(a);
+    const __m256d y = _mm256_cvtps_pd(b);
+    const __m256d z = _mm256_cvtps_pd(c);
+    __m128 gx = transformed_row(global_from_sensor, 0, x, y, z);
+    __m128 gy = transformed_row(global_from_sensor, 1, x, y, z);
+    __m128 gz = transformed_row(global_from_sensor, 2, x, y, z);
+    __m128 gi = _mm_cvtepi32_ps(_mm_setr_epi32(p[0].intensity, p[1].intensity, p[2].intensity, p[3].intensity));
+    _MM_TRANSPOSE4_PS(gx, gy, gz, gi);
+    _mm_storeu_ps(&out[0].x, gx);
+    _mm_storeu_ps(&out[1].x, gy);
+    _mm_storeu_ps(&out[2].x, gz);
+    _mm_storeu_ps(&out[3].x, gi);
+  }
+  const std::span<const vlp16::Point> rest = in.subspan(i);
+  copy_for_filter(rest, out);
+  const std::span<roi::PointXYZI> tail(out, rest.size());
+  roi::transform_points(global_from_sensor, tail, tail);
+}
+#endif
+
+// Points of one pose into the global frame, as the filter takes them.
+void place(const Eigen::Isometry3d& global_from_sensor, std::span<const vlp16::Point> in, roi::PointXYZI* out) {
+#if defined(__x86_64__) || defined(__i386__)
+  if (__builtin_cpu_supports("avx")) {
+    place_avx(global_from_sensor, in, out);
+    return;
+  }
+#endif
+  copy_for_filter(in, out);
+  const std::span<roi::PointXYZI> placed(out, in.size());
+  roi::transform_points(global_from_sensor, placed, placed);
 }
 
 }  // namespace
@@ -323,16 +393,11 @@ void SweepProcessor::add_points(const vlp16::Frame& frame, std::size_t first, Sw
 pose::PoseStatus SweepProcessor::filter_batch(const vlp16::Frame& frame, std::size_t first, std::size_t end,
                                               SweepSink& sink) {
   scratch_.resize(end - first);
-  for (std::size_t i = first; i < end; ++i) {
-    const vlp16::Point& p = frame.points[i];
-    scratch_[i - first] = roi::PointXYZI{p.x, p.y, p.z, static_cast<float>(p.intensity)};
-  }
-  const auto place = [&](std::size_t from, std::size_t to, const Eigen::Isometry3d& global_from_lidar) {
-    const std::span<roi::PointXYZI> run = std::span(scratch_).subspan(from - first, to - from);
-    roi::transform_points(global_from_lidar, run, run);
+  const auto place_run = [&](std::size_t from, std::size_t to, const Eigen::Isometry3d& global_from_lidar) {
+    place(global_from_lidar, std::span(frame.points).subspan(from, to - from), scratch_.data() + (from - first));
   };
   if (config_.pose_mode == PoseMode::kPerSweep) {
-    place(first, end, sweep_sensor_pose_);
+    place_run(first, end, sweep_sensor_pose_);
   } else {
     // Per firing: the points of one firing period (in time order) share a pose.
     for (std::size_t i = first; i < end;) {
@@ -342,7 +407,7 @@ pose::PoseStatus SweepProcessor::filter_batch(const vlp16::Frame& frame, std::si
       std::size_t j = i + 1;
       while (j < end && firing_.covers(frame.start_time_ns + frame.points[j].time_offset_ns))
         ++j;
-      place(i, j, *pose);
+      place_run(i, j, *pose);
       i = j;
     }
   }
