@@ -16,15 +16,15 @@ namespace {
 
 constexpr std::int64_t kSecond_ns = 1'000'000'000;
 
-// Hands each finished sweep to the publisher's ring (copied into a preallocated slot) with
-// the processing time it took.
+// Hands each finished sweep to the publisher's ring (its points exchanged with a preallocated
+// slot's) with the processing time it took.
 class RingSink final : public SweepSink {
  public:
   explicit RingSink(Pipeline& pipeline) : pipeline_(pipeline) {}
-  void on_sweep(const Sweep& sweep) override {
+  void on_sweep(Sweep& sweep) override {
     const std::int64_t now = steady_ns();
     const auto fill = [&](Sweep& slot) {
-      slot = sweep;  // vector assignment within the reserved capacity: no allocation
+      slot.take(sweep);  // arrays of the same reserved capacity exchanged: no allocation
       slot.processing_ns = accumulated_ns_ + (now - packet_start_ns_);
       slot.closing_packet_start_ns = packet_start_ns_;
       slot.handed_over_ns = now;

@@ -139,6 +139,18 @@ Eigen::Isometry3d PublishedPose::isometry() const {
   return roi::pose_from_position_quaternion(position_m, orientation);
 }
 
+void Sweep::take(Sweep& other) {
+  static_cast<SweepHeader&>(*this) = other;
+  x.swap(other.x);
+  y.swap(other.y);
+  z.swap(other.z);
+  intensity.swap(other.intensity);
+  ring.swap(other.ring);
+  return_type.swap(other.return_type);
+  time_offset_ns.swap(other.time_offset_ns);
+  point_index = other.point_index;  // kept for evaluations only: unreserved in the ring's slots
+}
+
 void Sweep::reserve(std::size_t points, std::size_t centre_count) {
   x.reserve(points);
   y.reserve(points);

@@ -131,7 +131,7 @@ Message decode(const std::vector<std::uint8_t>& bytes) {
 std::map<std::int64_t, std::size_t> reference_kept(const DaemonConfig& config) {
   struct Count final : trajroi::daemon::SweepSink {
     std::map<std::int64_t, std::size_t> kept;
-    void on_sweep(const trajroi::daemon::Sweep& s) override {
+    void on_sweep(trajroi::daemon::Sweep& s) override {
       if (s.filtered) kept[static_cast<std::int64_t>(s.index)] = s.size();
     }
   } sink;

@@ -60,7 +60,7 @@ std::unique_ptr<ActiveTrajectory> trajectory_from(const fs::path& file, std::int
 
 struct Collect final : trajroi::daemon::SweepSink {
   std::vector<Sweep> sweeps;
-  void on_sweep(const Sweep& s) override { sweeps.push_back(s); }
+  void on_sweep(Sweep& s) override { sweeps.push_back(s); }
 };
 
 // Feeds the run; `before_lidar(processor, sink)` runs before each lidar datagram. `with_gnss`
@@ -84,6 +84,66 @@ Collect drive(SweepProcessor& processor, bool with_gnss, Hook before_lidar) {
 
 Collect drive(SweepProcessor& processor, bool with_gnss = true) {
   return drive(processor, with_gnss, [](SweepProcessor&, Collect&) {});
+}
+
+// The publisher's ring takes a finished sweep's points by exchanging arrays: the header is
+// copied, every array's points move, the slot's old arrays (their capacity) go back.
+TEST(Sweep, TakeExchangesThePointArraysAndCopiesTheHeader) {
+  Sweep built, slot;
+  built.reserve(64, 8);
+  slot.reserve(64, 8);
+  built.index = 41;
+  built.filtered = true;
+  built.start_s_m = 12.5;
+  built.centres.resize(3);
+  built.x = {1.0f, 2.0f};
+  built.y = {3.0f, 4.0f};
+  built.z = {5.0f, 6.0f};
+  built.intensity = {7, 8};
+  built.ring = {9, 10};
+  built.return_type = {1, 3};
+  built.time_offset_ns = {11, 12};
+  built.point_index = {13, 14};
+  const Sweep expected = built;
+  const std::vector<const void*> built_arrays{built.x.data(),
+                                              built.y.data(),
+                                              built.z.data(),
+                                              built.intensity.data(),
+                                              built.ring.data(),
+                                              built.return_type.data(),
+                                              built.time_offset_ns.data()};
+  const std::vector<const void*> slot_arrays{slot.x.data(),
+                                             slot.y.data(),
+                                             slot.z.data(),
+                                             slot.intensity.data(),
+                                             slot.ring.data(),
+                                             slot.return_type.data(),
+                                             slot.time_offset_ns.data()};
+
+  slot.take(built);
+
+  EXPECT_EQ(slot.index, 41U);
+  EXPECT_TRUE(slot.filtered);
+  EXPECT_EQ(slot.start_s_m, 12.5);
+  EXPECT_EQ(slot.centres.size(), 3U);
+  EXPECT_EQ(slot.x, expected.x);
+  EXPECT_EQ(slot.y, expected.y);
+  EXPECT_EQ(slot.z, expected.z);
+  EXPECT_EQ(slot.intensity, expected.intensity);
+  EXPECT_EQ(slot.ring, expected.ring);
+  EXPECT_EQ(slot.return_type, expected.return_type);
+  EXPECT_EQ(slot.time_offset_ns, expected.time_offset_ns);
+  EXPECT_EQ(slot.point_index, expected.point_index);
+  // Exchanged, not copied: the points live where they were built, the slot's arrays (reserved
+  // alike) are the processor's for the next sweep.
+  EXPECT_EQ((std::vector<const void*>{slot.x.data(), slot.y.data(), slot.z.data(), slot.intensity.data(),
+                                      slot.ring.data(), slot.return_type.data(), slot.time_offset_ns.data()}),
+            built_arrays);
+  EXPECT_EQ((std::vector<const void*>{built.x.data(), built.y.data(), built.z.data(), built.intensity.data(),
+                                      built.ring.data(), built.return_type.data(), built.time_offset_ns.data()}),
+            slot_arrays);
+  EXPECT_GE(built.x.capacity(), 64U);
+  EXPECT_EQ(built.index, 41U);  // the processor's header is left as it was
 }
 
 TEST(SweepProcessor, TheRoiGrowsWithSpeedAndTheGrowthIsCapped) {

@@ -155,7 +155,7 @@ void run_pipelines(const ScenarioRun& run, std::span<const daemon::DaemonConfig>
     std::chrono::steady_clock::time_point packet_start;
     bool past_end = false;
     std::int64_t until_ns = 0;
-    void on_sweep(const daemon::Sweep& sweep) override {
+    void on_sweep(daemon::Sweep& sweep) override {
       sweep_ms += elapsed_ms(packet_start);
       observer->on_sweep(index, sweep, sweep_ms);
       sweep_ms = 0.0;

@@ -54,7 +54,8 @@ struct PublishedPose {
   [[nodiscard]] Eigen::Isometry3d isometry() const;
 };
 
-struct Sweep {
+// A sweep's description: everything but its kept points.
+struct SweepHeader {
   std::uint64_t index = 0;
   std::int64_t start_ns = 0;
   std::int64_t end_ns = 0;
@@ -90,14 +91,6 @@ struct Sweep {
   double start_s_m = 0.0, look_ahead_m = 0.0;
   std::vector<roi::Centre> centres;
 
-  // Kept points, global frame, structure of arrays.
-  std::vector<float> x, y, z;
-  std::vector<std::uint8_t> intensity, ring, return_type;
-  std::vector<std::int32_t> time_offset_ns;
-  // With SweepProcessor::keep_point_indices(): each kept point's index among the decoded
-  // sweep's points (vlp16::Frame::points), for scoring against per-point truth.
-  std::vector<std::uint32_t> point_index;
-
   // Steady-clock bookkeeping: when the last datagram with points of this sweep arrived (set
   // from set_input_arrival), and the processing time the wiring measured.
   std::int64_t last_packet_arrival_ns = 0;
@@ -107,7 +100,22 @@ struct Sweep {
   // its time went).
   std::int64_t closing_packet_start_ns = 0;
   std::int64_t handed_over_ns = 0;
+};
 
+struct Sweep : SweepHeader {
+  // Kept points, global frame, structure of arrays.
+  std::vector<float> x, y, z;
+  std::vector<std::uint8_t> intensity, ring, return_type;
+  std::vector<std::int32_t> time_offset_ns;
+  // With SweepProcessor::keep_point_indices(): each kept point's index among the decoded
+  // sweep's points (vlp16::Frame::points), for scoring against per-point truth.
+  std::vector<std::uint32_t> point_index;
+
+  // Becomes `other`: its header copied, its kept points taken by exchanging arrays, so that
+  // `other` is left with this sweep's arrays (their capacity: nothing is allocated, nothing
+  // copied, when both were reserved alike) and its points are to be cleared. The point
+  // indices are copied.
+  void take(Sweep& other);
   void reserve(std::size_t points, std::size_t centres);
   void clear_points() noexcept;
   [[nodiscard]] std::size_t size() const noexcept { return x.size(); }
@@ -118,8 +126,8 @@ enum class LidarPort : std::uint8_t { kData, kPosition };
 class SweepSink {
  public:
   virtual ~SweepSink() = default;
-  // `sweep` is valid during the call only.
-  virtual void on_sweep(const Sweep& sweep) = 0;
+  // `sweep` is valid during the call only; the sink may take its points (Sweep::take).
+  virtual void on_sweep(Sweep& sweep) = 0;
   // Every run of points as placed in the global frame, before the ROI: `placed[k]` is the
   // frame's point `first + k`. Only while the sweep's pose is valid. For the evaluations.
   virtual void on_placed(const vlp16::Frame& /*frame*/, std::size_t /*first*/,
