@@ -7,6 +7,7 @@
 #include <systemd/sd-daemon.h>
 #include <unistd.h>
 
+#include <future>
 #include <thread>
 #include <vector>
 
@@ -206,7 +207,11 @@ int run_daemon(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> tra
     log::critical("{}: {}", config.file.string(), e.what());
     return kExitConfig;
   }
-  log_scan_calibration(processor->calibrate_scan(), config.roi.shape);
+  // The scans are timed on another thread while the rings are allocated and touched and the
+  // sources opened (start-up is part of a replay's time); a path forced by TRAJROI_SIMD is
+  // taken at once.
+  std::future<roi::ScanCalibration> scan =
+      std::async(std::launch::async, [&processor] { return processor->calibrate_scan(); });
   const bool exact = options.replay.has_value() && options.rate == 0.0;
   Pipeline pipeline(config, exact, options.record.has_value());
   try {
@@ -234,6 +239,7 @@ int run_daemon(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> tra
   if (config.realtime.lock_memory) {
     if (const std::string w = lock_memory(); !w.empty()) log::warn("{}", w);
   }
+  log_scan_calibration(scan.get(), config.roi.shape);
   log::info("trajroid running: {} → LCM {} ({}, {}, {}, {}; trajectory input on {})",
             options.replay ? "replay of " + options.replay->string() : std::string("live sensors"), url,
             config.lcm.points, config.lcm.pose, config.lcm.roi, config.lcm.status, config.lcm.trajectory);
