@@ -15,6 +15,7 @@
 #include <map>
 #include <numbers>
 #include <set>
+#include <tuple>
 
 #include "pcd_reader.hpp"
 #include "test_data.hpp"
@@ -419,6 +420,50 @@ TEST(Vlp16Capture, NebulaDualReturnReferenceCloudIsReproducedPointForPoint) {
 
 // A capture cut inside a record: every whole record before the cut is delivered, then an
 // error that says so.
+// decode() runs an AVX2 build of the decoder where the processor has AVX2: on real strongest
+// and dual captures, with the default calibration and nebula's (rotation corrections, range
+// limits), it must give the baseline build's points bit for bit, and its counts.
+TEST(Vlp16Capture, TheAvx2DecoderGivesTheBaselinesPointsBitForBit) {
+  TRAJROI_REQUIRE_DATA(strongest, "velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap");
+  TRAJROI_REQUIRE_DATA(dual, "velodyne/vlp16/nebula_vlp16_dual_1673400471.DERIVED.pcap");
+  TRAJROI_REQUIRE_DATA(yaml, "velodyne/vlp16/nebula_VLP16_calibration.yaml");
+  if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this processor has no AVX2: decode() runs the baseline only";
+  DecodeOptions limited;
+  limited.min_range_m = 0.3;
+  limited.max_range_m = 30.0;
+  const PacketDecoder plain(Calibration::vlp16_default());
+  const PacketDecoder corrected(parse_calibration_yaml(test::read_file(yaml), yaml.string()), limited);
+  for (const auto& path : {strongest, dual}) {
+    for (const PacketDecoder* decoder : {&plain, &corrected}) {
+      PcapSource source(path);
+      Datagram datagram;
+      std::vector<Point> baseline, avx2;
+      std::size_t packets = 0;
+      while (source.next(datagram) == PacketSource::Next::kDatagram) {
+        if (validate_data_packet(datagram.payload) != PacketError::kNone) continue;
+        ++packets;
+        baseline.clear();
+        avx2.clear();
+        const PacketDecoder::Result a = decoder->decode_baseline(datagram.payload, baseline);
+        const PacketDecoder::Result b = decoder->decode_avx2(datagram.payload, avx2);
+        ASSERT_EQ(std::tie(a.points, a.no_return, a.out_of_range, a.merged_returns),
+                  std::tie(b.points, b.no_return, b.out_of_range, b.merged_returns));
+        ASSERT_EQ(baseline.size(), avx2.size());
+        for (std::size_t i = 0; i < baseline.size(); ++i) {
+          const Point& p = baseline[i];
+          const Point& q = avx2[i];
+          ASSERT_TRUE(std::memcmp(&p.x, &q.x, 5 * sizeof(float)) == 0 && p.time_offset_ns == q.time_offset_ns &&
+                      p.intensity == q.intensity && p.laser == q.laser && p.ring == q.ring &&
+                      p.return_type == q.return_type)
+              << path << " packet " << packets << " point " << i << ": " << p.x << " " << p.y << " " << p.z
+              << " against " << q.x << " " << q.y << " " << q.z;
+        }
+      }
+      EXPECT_GT(packets, 290u) << path;
+    }
+  }
+}
+
 TEST(Vlp16Capture, TruncatedCaptureDeliversEveryWholeRecordThenAnError) {
   TRAJROI_REQUIRE_DATA(path, "velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap");
   const std::string bytes = test::read_file(path);

@@ -87,6 +87,12 @@ class PacketDecoder {
   // Appends the points of one packet that validate_data_packet() accepted. Never reads
   // outside the packet; allocates only if `out` must grow.
   Result decode(std::span<const std::uint8_t> packet, std::vector<Point>& out) const;
+  // decode() as compiled for every x86-64, and for processors with AVX2 (the same arithmetic
+  // in the same order, without fused multiply-adds: the same points). decode() calls the one
+  // the processor runs; these are for tests and benchmarks (decode_avx2 only where the
+  // processor has AVX2).
+  Result decode_baseline(std::span<const std::uint8_t> packet, std::vector<Point>& out) const;
+  Result decode_avx2(std::span<const std::uint8_t> packet, std::vector<Point>& out) const;
 
  private:
   struct Laser {
@@ -104,6 +110,7 @@ class PacketDecoder {
   // The directions of the channels of a block at `azimuth`, advancing by `gap` over it, in
   // loops without branches (the compiler vectorizes them).
   void directions(std::uint16_t azimuth, std::uint32_t gap, Directions& d) const noexcept;
+  Result decode_body(std::span<const std::uint8_t> packet, std::vector<Point>& out) const;
   struct AngleTables;
   [[nodiscard]] static const AngleTables& angle_tables();  // built at the first call, then shared
   DecodeOptions options_;
