@@ -245,6 +245,64 @@ TEST(PoseBuffer, AttitudesAreExactlyEigensSlerp) {
   }
 }
 
+// A query held at the newest attitude (most of the daemon's: the IMU's frames come after the
+// points they cover) takes the rotation and turned lever arm the attitude stored as it came;
+// FiringPoses keeps the rotation's part of global_from_sensor while the attitude stays. Both
+// must still be Eigen's own results bit for bit, through new attitudes, new fixes and a
+// return to an attitude seen before.
+TEST(FiringPoses, HeldAttitudesAndKeptRotationsAreEigensResultsBitForBit) {
+  const Eigen::Vector3d lever(-0.2, 0.05, 0.9);
+  PoseGate gate;
+  gate.max_extrapolation_ns = 100'000'000;
+  PoseBuffer buf(gate, lever, 16);
+  const Eigen::Isometry3d robot_from_sensor =
+      Eigen::Translation3d(0.1, -0.03, 0.7) * Eigen::AngleAxisd(0.02, Eigen::Vector3d(0.3, -0.2, 0.9).normalized());
+  FiringPoses firing(buf, robot_from_sensor, 55'296);
+  const auto turned = [](double roll, double pitch, double yaw) {
+    return Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                              Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                              Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()));
+  };
+  std::vector<Eigen::Quaterniond> attitudes;
+  std::vector<GnssFix> fixes;
+  // The antenna at t: extrapolated from the last two fixes (held at the first one alone).
+  const auto antenna_at = [&fixes](std::int64_t t) {
+    const GnssFix& a = fixes.back();
+    if (fixes.size() < 2) return a.antenna_global_m;
+    const GnssFix& prev = fixes[fixes.size() - 2];
+    const Eigen::Vector3d velocity =
+        (a.antenna_global_m - prev.antenna_global_m) / static_cast<double>(a.t_ns - prev.t_ns);
+    return Eigen::Vector3d(a.antenna_global_m + velocity * static_cast<double>(t - a.t_ns));
+  };
+  std::int64_t queries = 0;
+  for (int k = 0; k < 12; ++k) {
+    const std::int64_t t0 = k * 5'000'000;  // an IMU frame every 5 ms, a fix every 20 ms
+    if (k % 4 == 0) {
+      fixes.push_back(fix(t0 / 1'000'000, 0.3 * k, -0.1 * k));
+      ASSERT_TRUE(buf.add_fix(fixes.back()));
+    }
+    const Eigen::Quaterniond q = k == 7 ? attitudes[3] : turned(0.01 * k, -0.005 * k, 0.7 + 0.04 * k);
+    attitudes.push_back(q);
+    ASSERT_TRUE(buf.add_attitude({t0, q}));
+    firing.reset();  // a new query at t0 (its rotation part kept from before: the case to check)
+    for (std::int64_t t = t0; t < t0 + 5'000'000; t += 55'296, ++queries) {  // held at this attitude
+      const Eigen::Quaterniond held = q.normalized();
+      PoseStatus status{};
+      const Eigen::Isometry3d* pose = firing.at(t, status);
+      ASSERT_NE(pose, nullptr) << to_string(status);
+      const PoseQuery direct = buf.pose_at(t);
+      ASSERT_TRUE(direct.valid());
+      Eigen::Isometry3d robot = Eigen::Isometry3d::Identity();
+      robot.linear() = held.toRotationMatrix();
+      robot.translation() = antenna_at(t) - held * lever;
+      ASSERT_EQ(direct.global_from_robot.matrix(), robot.matrix()) << "t " << t;
+      const Eigen::Isometry3d expected = robot * robot_from_sensor;
+      ASSERT_EQ(pose->matrix(), expected.matrix()) << "t " << t;
+    }
+  }
+  EXPECT_GT(queries, 1000);
+}
+
 TEST(PoseBuffer, LeverArmIsRotatedWithTheRobot) {
   PoseBuffer buf(PoseGate{}, Eigen::Vector3d(-0.5, 0.0, 1.2));  // antenna behind and above
   ASSERT_TRUE(buf.add_fix(fix(0, 10.0, 20.0)));

@@ -132,6 +132,8 @@ bool PoseBuffer::add_attitude(const AttitudeSample& a) noexcept {
   StoredAttitude stored;
   stored.t_ns = a.t_ns;
   stored.global_from_robot = a.global_from_robot.normalized();
+  stored.rotation = stored.global_from_robot.toRotationMatrix();
+  stored.lever_arm_global_m = stored.global_from_robot * antenna_in_robot_m_;
   if (attitudes_.size > 0) {
     // As Eigen's slerp computes them (Quaternion.h), so that interpolating gives its results.
     const Eigen::Quaterniond& previous = attitudes_.newest().global_from_robot;
@@ -225,13 +227,13 @@ PoseQuery PoseBuffer::pose_at(std::int64_t t_ns) const noexcept {
   }
 
   // Attitude.
-  Eigen::Quaterniond attitude;
   const std::size_t r = attitudes_.floor(t_ns);
   if (r == attitudes_.size) {
     out.status = PoseStatus::kBeforeFirstSample;
     return out;
   }
-  const AttitudeSample& qa = attitudes_.at(r);
+  const StoredAttitude& qa = attitudes_.at(r);
+  out.global_from_robot = Eigen::Isometry3d::Identity();
   if (r + 1 < attitudes_.size) {
     const StoredAttitude& qb = attitudes_.at(r + 1);
     if (qb.t_ns - qa.t_ns > gate_.max_gap_ns) {
@@ -247,17 +249,17 @@ PoseQuery PoseBuffer::pose_at(std::int64_t t_ns) const noexcept {
       scale1 = std::sin(w * pair.theta) / pair.sin_theta;
     }
     if (pair.dot < 0.0) scale1 = -scale1;
-    attitude = Eigen::Quaterniond(scale0 * qa.global_from_robot.coeffs() + scale1 * qb.global_from_robot.coeffs());
+    const Eigen::Quaterniond attitude(scale0 * qa.global_from_robot.coeffs() + scale1 * qb.global_from_robot.coeffs());
+    out.global_from_robot.linear() = attitude.toRotationMatrix();
+    out.global_from_robot.translation() = antenna - attitude * antenna_in_robot_m_;
   } else {
     if (t_ns - qa.t_ns > gate_.max_extrapolation_ns) {
       return fail(PoseStatus::kAttitudeTooOld, t_ns - qa.t_ns, gate_.max_extrapolation_ns);
     }
-    attitude = qa.global_from_robot;  // held within the bound
+    // Held within the bound: what the attitude alone gives was computed as it arrived.
+    out.global_from_robot.linear() = qa.rotation;
+    out.global_from_robot.translation() = antenna - qa.lever_arm_global_m;
   }
-
-  out.global_from_robot = Eigen::Isometry3d::Identity();
-  out.global_from_robot.linear() = attitude.toRotationMatrix();
-  out.global_from_robot.translation() = antenna - attitude * antenna_in_robot_m_;
   out.status = PoseStatus::kValid;
   return out;
 }

@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -136,8 +137,13 @@ class PoseBuffer {
     double sin_theta = 0.0;
     bool linear = true;  // |dot| ≥ 1 − ε: Eigen interpolates the coefficients linearly
   };
+  // Also what a query held at this attitude (the newest, within the extrapolation bound: most
+  // queries, as the IMU's frames come after the points they cover) computes from it alone: its
+  // rotation matrix and the lever arm turned by it, taken once as it arrives.
   struct StoredAttitude : AttitudeSample {
     SlerpPair from_previous;
+    Eigen::Matrix3d rotation;
+    Eigen::Vector3d lever_arm_global_m;
   };
 
   PoseGate gate_;
@@ -170,10 +176,21 @@ class FiringPoses {
       limit_ = q.limit;
       have_ = true;
       query_ns_ = t_ns;
-      if (q.valid()) global_from_sensor_ = q.global_from_robot * robot_from_sensor_;
+      if (q.valid()) place_sensor(q.global_from_robot);
     }
     status = status_;
     return status_ == PoseStatus::kValid ? &global_from_sensor_ : nullptr;
+  }
+  // global_from_sensor_ = global_from_robot * robot_from_sensor_ as Eigen computes it
+  // (linear: the rotations' product; translation: R · sensor offset, then + robot position),
+  // the parts that depend on the rotation alone kept from the last query when it is the same.
+  void place_sensor(const Eigen::Isometry3d& global_from_robot) noexcept {
+    if (global_from_robot.linear() != last_robot_rotation_) {
+      last_robot_rotation_ = global_from_robot.linear();
+      global_from_sensor_.linear() = global_from_robot.linear() * robot_from_sensor_.linear();
+      turned_sensor_offset_ = global_from_robot.linear() * robot_from_sensor_.translation();
+    }
+    global_from_sensor_.translation() = turned_sensor_offset_ + global_from_robot.translation();
   }
   // Whether at(t) would answer the last query's pose without a new one.
   [[nodiscard]] bool covers(std::int64_t t_ns) const noexcept {
@@ -193,6 +210,10 @@ class FiringPoses {
   PoseStatus status_ = PoseStatus::kNoGnss;
   double measured_ = 0.0, limit_ = 0.0;
   Eigen::Isometry3d global_from_sensor_ = Eigen::Isometry3d::Identity();
+  // The last product's rotation part: while the robot's attitude is the same (held between
+  // IMU frames), global_from_sensor's rotation and the turned sensor offset are too.
+  Eigen::Matrix3d last_robot_rotation_ = Eigen::Matrix3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  Eigen::Vector3d turned_sensor_offset_ = Eigen::Vector3d::Zero();
 };
 
 }  // namespace trajroi::pose
