@@ -34,7 +34,7 @@ class SpscRing {
   // `capacity` is rounded up to a power of two (at least 2). Every slot is constructed now
   // with `make()` (or value-initialised) and its memory touched, so the steady state takes no
   // page faults.
-  explicit SpscRing(std::size_t capacity) : SpscRing(capacity, [] { return T{}; }) {}
+  explicit SpscRing(std::size_t capacity) : mask_(round_up(capacity) - 1), slots_(new Slot[mask_ + 1]()) {}
   template <typename Make>
   SpscRing(std::size_t capacity, Make make) : mask_(round_up(capacity) - 1), slots_(new Slot[mask_ + 1]) {
     for (std::size_t i = 0; i <= mask_; ++i)
