@@ -206,7 +206,7 @@ SweepProcessor::SweepProcessor(const DaemonConfig& config, std::unique_ptr<Activ
   const double longest = r.look_ahead_m + r.max_speed_mps * r.look_ahead_per_mps_s;
   const auto centres = static_cast<std::size_t>(longest / (r.spacing_ratio * size_along(r))) + 2;
   sweep_.reserve(config_.buffers.max_points_per_sweep, centres);
-  scratch_.reserve(kScratchPoints);
+  scratch_.resize(kScratchPoints);  // used as [0, batch): never resized (value-initialising) after
   kept_.reserve(kScratchPoints);
   roi::place_centres(active_->trajectory, 0.0, longest, r.spacing_ratio * size_along(r), sweep_.centres);
   circles_.assign(sweep_.centres);
@@ -404,7 +404,6 @@ void SweepProcessor::add_points(const vlp16::Frame& frame, std::size_t first, Sw
 
 pose::PoseStatus SweepProcessor::filter_batch(const vlp16::Frame& frame, std::size_t first, std::size_t end,
                                               SweepSink& sink) {
-  scratch_.resize(end - first);
   const auto place_run = [&](std::size_t from, std::size_t to, const Eigen::Isometry3d& global_from_lidar) {
     place(global_from_lidar, std::span(frame.points).subspan(from, to - from), scratch_.data() + (from - first));
   };
@@ -423,7 +422,7 @@ pose::PoseStatus SweepProcessor::filter_batch(const vlp16::Frame& frame, std::si
       i = j;
     }
   }
-  const std::span<const roi::PointXYZI> placed(scratch_);
+  const std::span<const roi::PointXYZI> placed(scratch_.data(), end - first);
   sink.on_placed(frame, first, placed);
   if (config_.roi.shape == RoiShape::kCircular) {
     (void)circle_grid_.filter(placed, kept_);
