@@ -10,8 +10,8 @@
 namespace trajroi::daemon {
 namespace {
 
-template <typename T>
-void copy_into(std::vector<T>& out, const std::vector<T>& in) {
+template <typename T, typename Allocator>
+void copy_into(std::vector<T>& out, const std::vector<T, Allocator>& in) {
   out.assign(in.begin(), in.end());
 }
 
@@ -30,8 +30,8 @@ void store_be32(std::uint8_t* p, std::uint32_t v) noexcept {
 }
 
 // LCM's big-endian 32-bit elements (float bits as they are), in a loop the compiler vectorizes.
-template <typename T>
-std::uint8_t* store_be32_array(std::uint8_t* out, const std::vector<T>& values) noexcept {
+template <typename T, typename Allocator>
+std::uint8_t* store_be32_array(std::uint8_t* out, const std::vector<T, Allocator>& values) noexcept {
   static_assert(sizeof(T) == sizeof(std::uint32_t));
   for (std::size_t i = 0; i < values.size(); ++i) {
     std::uint32_t v;

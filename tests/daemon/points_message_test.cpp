@@ -12,6 +12,12 @@
 
 namespace {
 
+// A sweep's array as the plain vector the message decodes to.
+template <typename T, typename Allocator>
+std::vector<T> plain(const std::vector<T, Allocator>& v) {
+  return {v.begin(), v.end()};
+}
+
 using trajroi::daemon::PoseMode;
 using trajroi::daemon::Sweep;
 
@@ -82,14 +88,14 @@ TEST(PointsMessage, TheBytesDecodeToTheSweep) {
   EXPECT_EQ(m.points_in, 57'600);
   EXPECT_EQ(m.pose_mode, trajroi::points_t::POSE_PER_FIRING);
   ASSERT_EQ(m.num_points, 101);
-  EXPECT_EQ(m.x, s.x);
+  EXPECT_EQ(m.x, plain(s.x));
   EXPECT_TRUE(std::signbit(m.x[0]));
-  EXPECT_EQ(m.y, s.y);
-  EXPECT_EQ(m.z, s.z);
-  EXPECT_EQ(m.intensity, s.intensity);
-  EXPECT_EQ(m.ring, s.ring);
-  EXPECT_EQ(m.return_type, s.return_type);
-  EXPECT_EQ(m.time_offset_ns, s.time_offset_ns);
+  EXPECT_EQ(m.y, plain(s.y));
+  EXPECT_EQ(m.z, plain(s.z));
+  EXPECT_EQ(m.intensity, plain(s.intensity));
+  EXPECT_EQ(m.ring, plain(s.ring));
+  EXPECT_EQ(m.return_type, plain(s.return_type));
+  EXPECT_EQ(m.time_offset_ns, plain(s.time_offset_ns));
   EXPECT_DOUBLE_EQ(m.sensor_position_m[2], 1.2);
 }
 

@@ -29,6 +29,7 @@
 #include "trajroi/pose/pose_buffer.hpp"
 #include "trajroi/pose_input/pose_input.hpp"
 #include "trajroi/roi/centres.hpp"
+#include "trajroi/roi/filter_stats.hpp"
 #include "trajroi/roi/grid_filter.hpp"
 #include "trajroi/roi/point.hpp"
 #include "trajroi/roi/shapes.hpp"
@@ -103,13 +104,16 @@ struct SweepHeader {
 };
 
 struct Sweep : SweepHeader {
+  // Grown by resize() and then written: its new elements are left unwritten, not zeroed.
+  template <typename T>
+  using Array = std::vector<T, roi::DefaultInitAllocator<T>>;
   // Kept points, global frame, structure of arrays.
-  std::vector<float> x, y, z;
-  std::vector<std::uint8_t> intensity, ring, return_type;
-  std::vector<std::int32_t> time_offset_ns;
+  Array<float> x, y, z;
+  Array<std::uint8_t> intensity, ring, return_type;
+  Array<std::int32_t> time_offset_ns;
   // With SweepProcessor::keep_point_indices(): each kept point's index among the decoded
   // sweep's points (vlp16::Frame::points), for scoring against per-point truth.
-  std::vector<std::uint32_t> point_index;
+  Array<std::uint32_t> point_index;
 
   // Becomes `other`: its header copied, its kept points taken by exchanging arrays, so that
   // `other` is left with this sweep's arrays (their capacity: nothing is allocated, nothing
