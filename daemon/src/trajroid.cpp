@@ -7,6 +7,7 @@
 #include <systemd/sd-daemon.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <future>
 #include <thread>
 #include <vector>
@@ -27,6 +28,11 @@
 namespace trajroi::daemon {
 
 namespace {
+
+// An as-fast-as-possible replay waits on a full ring instead of dropping, so its ring only
+// covers the reader's pauses: this many packets (≈ 2 ms of processing) at most, not the live
+// depth (seconds of packets, 5 MB written at start-up).
+constexpr std::size_t kExactReplayRing = 512;
 
 // gnss.configure / imu.configure: the receiver's output set each time its device opens; the
 // outcome (and each refused step) is said with the open.
@@ -58,8 +64,10 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
     inputs::RecordedOptions recorded;
     recorded.rate = options.rate;
     recorded.loop = options.loop;
-    pipeline.add_input(std::make_unique<inputs::RecordedInput>(*options.replay, recorded), config.buffers.lidar_packets,
-                       "trajroid-replay", config.realtime.lidar);
+    const std::size_t ring =
+        options.rate == 0.0 ? std::min(config.buffers.lidar_packets, kExactReplayRing) : config.buffers.lidar_packets;
+    pipeline.add_input(std::make_unique<inputs::RecordedInput>(*options.replay, recorded), ring, "trajroid-replay",
+                       config.realtime.lidar);
     return;
   }
   vlp16::UdpOptions udp;
