@@ -67,6 +67,13 @@ struct Point {
   ReturnType return_type;
 };
 
+// Up to this azimuth step between firings (5°; a VLP-16 at 20 Hz steps 0.8°) the in-block
+// rotation δ ≤ 0.09 rad is turned into cos/sin by series, whose truncation error (δ⁷/5040 <
+// 1e-11) is far below float resolution, and centidegrees become degrees by a multiplication
+// (the same float as the division). Larger steps only occur in damaged data; they take the
+// library cos/sin and the division.
+inline constexpr std::uint32_t kSeriesGapLimit_cdeg = 500;
+
 struct DecodeOptions {
   double min_range_m = 0.0;  // inclusive; ranges outside are dropped (and counted)
   double max_range_m = std::numeric_limits<double>::infinity();
