@@ -303,6 +303,31 @@ TEST(FiringPoses, HeldAttitudesAndKeptRotationsAreEigensResultsBitForBit) {
   EXPECT_GT(queries, 1000);
 }
 
+// Past the newest fix the position is extrapolated with the velocity from the fix before,
+// only when that one passed the gate and came close enough before; else it is held.
+TEST(PoseBuffer, ExtrapolatesOnlyFromAPreviousFixThatPassedAndWasClose) {
+  PoseGate gate;
+  gate.max_extrapolation_ns = 100'000'000;
+  gate.max_gap_ns = 300'000'000;
+  FixQuality bad = good();
+  bad.fix_type = 1;
+  for (const bool previous_passes : {true, false}) {
+    for (const std::int64_t previous_ms : {0, -500}) {  // 100 ms before the newest, or 600 ms (a gap)
+      PoseBuffer buf(gate, Eigen::Vector3d::Zero());
+      ASSERT_TRUE(buf.add_attitude(yaw_at(140, 0.0)));  // held within the bound at 150 ms
+      ASSERT_TRUE(buf.add_fix(fix(previous_ms, 0.0, 0.0, previous_passes ? good() : bad)));
+      ASSERT_TRUE(buf.add_fix(fix(100, 1.0, -2.0)));
+      const PoseQuery q = buf.pose_at(150'000'000);
+      ASSERT_TRUE(q.valid()) << to_string(q.status);
+      const bool extrapolates = previous_passes && previous_ms == 0;
+      const Eigen::Vector3d expected = extrapolates ? Eigen::Vector3d(1.5, -3.0, 0.0) : Eigen::Vector3d(1.0, -2.0, 0.0);
+      EXPECT_TRUE(q.global_from_robot.translation().isApprox(expected, 1e-12))
+          << "previous passes " << previous_passes << ", at " << previous_ms
+          << " ms: " << q.global_from_robot.translation().transpose();
+    }
+  }
+}
+
 TEST(PoseBuffer, LeverArmIsRotatedWithTheRobot) {
   PoseBuffer buf(PoseGate{}, Eigen::Vector3d(-0.5, 0.0, 1.2));  // antenna behind and above
   ASSERT_TRUE(buf.add_fix(fix(0, 10.0, 20.0)));

@@ -115,7 +115,17 @@ bool PoseBuffer::add_fix(const GnssFix& fix) noexcept {
     ++counters_.out_of_order;
     return false;
   }
-  fixes_.push(fix);
+  StoredFix stored;
+  static_cast<GnssFix&>(stored) = fix;
+  if (fixes_.size > 0) {
+    const GnssFix& prev = fixes_.newest();
+    PoseQuery ignored;
+    if (fix.t_ns - prev.t_ns <= gate_.max_gap_ns && check(prev.quality, ignored) == PoseStatus::kValid) {
+      stored.extrapolates = true;
+      stored.velocity = (fix.antenna_global_m - prev.antenna_global_m) / static_cast<double>(fix.t_ns - prev.t_ns);
+    }
+  }
+  fixes_.push(stored);
   ++counters_.fixes;
   return true;
 }
@@ -196,7 +206,7 @@ PoseQuery PoseBuffer::pose_at(std::int64_t t_ns) const noexcept {
     out.status = PoseStatus::kBeforeFirstSample;
     return out;
   }
-  const GnssFix& a = fixes_.at(f);
+  const StoredFix& a = fixes_.at(f);
   if (PoseStatus s = check(a.quality, out); s != PoseStatus::kValid) {
     out.status = s;
     return out;
@@ -214,16 +224,9 @@ PoseQuery PoseBuffer::pose_at(std::int64_t t_ns) const noexcept {
     const std::int64_t ahead = t_ns - a.t_ns;
     if (ahead > gate_.max_extrapolation_ns) return fail(PoseStatus::kGnssTooOld, ahead, gate_.max_extrapolation_ns);
     antenna = a.antenna_global_m;
-    // Linear extrapolation from the last two fixes when they are close enough and both pass.
-    if (f > 0 && ahead > 0) {
-      const GnssFix& prev = fixes_.at(f - 1);
-      PoseQuery ignored;
-      if (a.t_ns - prev.t_ns <= gate_.max_gap_ns && check(prev.quality, ignored) == PoseStatus::kValid) {
-        const Eigen::Vector3d velocity =
-            (a.antenna_global_m - prev.antenna_global_m) / static_cast<double>(a.t_ns - prev.t_ns);
-        antenna += velocity * static_cast<double>(ahead);
-      }
-    }
+    // Linear extrapolation from the last two fixes when they are close enough and both pass
+    // (the previous one still held: its velocity was taken as this one arrived).
+    if (f > 0 && ahead > 0 && a.extrapolates) antenna += a.velocity * static_cast<double>(ahead);
   }
 
   // Attitude.

@@ -146,9 +146,16 @@ class PoseBuffer {
     Eigen::Vector3d lever_arm_global_m;
   };
 
+  // Also the velocity from the previous fix, when a query after this fix extrapolates with it
+  // (the two close enough, the previous passing the gate): taken once as it arrives.
+  struct StoredFix : GnssFix {
+    bool extrapolates = false;
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // m/ns
+  };
+
   PoseGate gate_;
   Eigen::Vector3d antenna_in_robot_m_;
-  Ring<GnssFix> fixes_;
+  Ring<StoredFix> fixes_;
   Ring<StoredAttitude> attitudes_;
   PoseBufferCounters counters_;
   std::optional<Eigen::Isometry3d> held_;
