@@ -37,8 +37,10 @@ figures() {  # rate → "latency_p50 latency_p99 drops wall_s cpu_s pipeline_cpu
 
 echo "scenario: tests/daemon/corridor.yaml, dual return, ${duration} s of data"
 # Where these figures come from: the CPU, its cores, and the ROI scan trajroid calibrated.
-scan=$("$build/daemon/trajroid" --config "$run/trajroid.yaml" --replay "$run" --rate max 2>&1 | grep "roi scan for" || true)
-echo "machine and scan: ${scan#*roi scan for }"
+start=$("$build/daemon/trajroid" --config "$run/trajroid.yaml" --replay "$run" --rate max 2>&1)
+scan=$(grep "roi scan for" <<<"$start" || true)
+decoder=$(grep "vlp16 decoder:" <<<"$start" || true)
+echo "machine and scan: ${scan#*roi scan for }; decoder: ${decoder#*vlp16 decoder: }"
 # Five real-time runs: the goals are the medians (one run's tail is one spell of the machine).
 runs=${TRAJROI_FIGURE_RUNS:-5}
 table=$(for _ in $(seq 1 "$runs"); do figures realtime; done)

@@ -111,6 +111,7 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
 void log_scan_calibration(const roi::ScanCalibration& c, RoiShape shape) {
   log::info("roi scan for {}: {} on {}", shape == RoiShape::kCircular ? "circles" : "rectangles", roi::describe(c),
             roi::describe_machine());
+  log::info("vlp16 decoder: {}", vlp16::describe(vlp16::decoder_calibration()));
 }
 
 // Signals go to the main thread only, through a signalfd (-1 when not handled).
@@ -215,11 +216,13 @@ int run_daemon(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> tra
     log::critical("{}: {}", config.file.string(), e.what());
     return kExitConfig;
   }
-  // The scans are timed on another thread while the rings are allocated and touched and the
-  // sources opened (start-up is part of a replay's time); a path forced by TRAJROI_SIMD is
-  // taken at once.
-  std::future<roi::ScanCalibration> scan =
-      std::async(std::launch::async, [&processor] { return processor->calibrate_scan(); });
+  // The decoder's builds and the scans are timed on another thread while the rings are
+  // allocated and touched and the sources opened (start-up is part of a replay's time); a
+  // path forced by TRAJROI_SIMD is taken at once.
+  std::future<roi::ScanCalibration> scan = std::async(std::launch::async, [&processor] {
+    (void)vlp16::decoder_calibration();
+    return processor->calibrate_scan();
+  });
   const bool exact = options.replay.has_value() && options.rate == 0.0;
   Pipeline pipeline(config, exact, options.record.has_value());
   try {

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "packet_builder.hpp"
@@ -156,6 +157,39 @@ TEST(Vlp16Decoder, EveryChannelsAzimuthIsTheInterpolationInDegrees) {
     }
   }
   EXPECT_GT(checked, 1'000'000u);
+}
+
+// decode() runs the build the start-up timing chose: TRAJROI_SIMD forces one without timing;
+// else, where the processor has AVX2, both are timed and the AVX2 build is taken unless the
+// baseline is at least 3 % faster.
+TEST(Vlp16Decoder, TheDecoderBuildIsTimedOrForced) {
+  const bool avx2 = __builtin_cpu_supports("avx2");
+  for (const char* path : {"scalar", "sse2"}) {
+    const DecoderCalibration c = calibrate_decoder(path);
+    EXPECT_TRUE(c.forced) << path;
+    EXPECT_EQ(c.chosen, DecoderBuild::kBaseline) << path;
+    EXPECT_EQ(describe(c), "baseline (forced by TRAJROI_SIMD)");
+  }
+  for (const char* path : {"avx2", "avx512"}) {
+    const DecoderCalibration c = calibrate_decoder(path);
+    EXPECT_TRUE(c.forced) << path;
+    EXPECT_EQ(c.chosen, avx2 ? DecoderBuild::kAvx2 : DecoderBuild::kBaseline) << path;
+  }
+  for (const char* path : {static_cast<const char*>(nullptr), "", "auto"}) {
+    const DecoderCalibration c = calibrate_decoder(path);
+    EXPECT_FALSE(c.forced);
+    EXPECT_EQ(c.avx2_available, avx2);
+    if (!avx2) {
+      EXPECT_EQ(c.chosen, DecoderBuild::kBaseline);
+      EXPECT_EQ(describe(c), "baseline (no AVX2)");
+      continue;
+    }
+    EXPECT_GT(c.baseline_ns_per_point, 0.0);
+    EXPECT_GT(c.avx2_ns_per_point, 0.0);
+    EXPECT_EQ(c.chosen,
+              c.baseline_ns_per_point < 0.97 * c.avx2_ns_per_point ? DecoderBuild::kBaseline : DecoderBuild::kAvx2);
+    EXPECT_NE(describe(c).find(std::string(to_string(c.chosen)) + " (avx2 "), std::string::npos) << describe(c);
+  }
 }
 
 TEST(Vlp16Decoder, LastReturnModeAndRangeLimits) {

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -79,6 +80,31 @@ struct DecodeOptions {
   double max_range_m = std::numeric_limits<double>::infinity();
 };
 
+// The two builds of the decoder (the same arithmetic in the same order: the same points):
+// compiled for every x86-64, and for processors with AVX2.
+enum class DecoderBuild : std::uint8_t { kBaseline, kAvx2 };
+[[nodiscard]] std::string_view to_string(DecoderBuild build) noexcept;
+
+// Which build PacketDecoder::decode() runs here. Where the processor has AVX2, both decode
+// the same synthetic packets (dual and strongest return, every channel returning) and the
+// AVX2 build is taken unless the baseline is clearly (3 %) faster. TRAJROI_SIMD forces it:
+// scalar or sse2 the baseline, avx2 or avx512 the AVX2 build (where the processor has it).
+struct DecoderCalibration {
+  DecoderBuild chosen = DecoderBuild::kBaseline;
+  bool forced = false;                 // by TRAJROI_SIMD: nothing was timed
+  bool avx2_available = false;         // the processor has AVX2
+  double baseline_ns_per_point = 0.0;  // as timed (0: not timed)
+  double avx2_ns_per_point = 0.0;
+};
+// Times the builds now (`forced`: TRAJROI_SIMD's value, or null).
+[[nodiscard]] DecoderCalibration calibrate_decoder(const char* forced);
+// The process's choice: calibrate_decoder(TRAJROI_SIMD) once, at the first call (the first
+// decode() makes it if nothing did before).
+[[nodiscard]] const DecoderCalibration& decoder_calibration();
+// "avx2 (avx2 5.12, baseline 5.31 ns per point)", "baseline (forced by TRAJROI_SIMD)",
+// "baseline (no AVX2)".
+[[nodiscard]] std::string describe(const DecoderCalibration& calibration);
+
 class PacketDecoder {
  public:
   explicit PacketDecoder(const Calibration& calibration, DecodeOptions options = {});
@@ -96,8 +122,8 @@ class PacketDecoder {
   Result decode(std::span<const std::uint8_t> packet, std::vector<Point>& out) const;
   // decode() as compiled for every x86-64, and for processors with AVX2 (the same arithmetic
   // in the same order, without fused multiply-adds: the same points). decode() calls the one
-  // the processor runs; these are for tests and benchmarks (decode_avx2 only where the
-  // processor has AVX2).
+  // decoder_calibration() chose; these are for tests and benchmarks (decode_avx2 only where
+  // the processor has AVX2).
   Result decode_baseline(std::span<const std::uint8_t> packet, std::vector<Point>& out) const;
   Result decode_avx2(std::span<const std::uint8_t> packet, std::vector<Point>& out) const;
 
