@@ -50,31 +50,12 @@ const Capture& dual_capture() {
 // The decoder build decode() runs here, as its start-up timing chose it.
 const int kDecoderContext = (benchmark::AddCustomContext("vlp16 decoder", describe(decoder_calibration())), 0);
 
-// PacketDecoder alone: bytes to points, output vector reused.
-void BM_DecodePackets(benchmark::State& state, const Capture& (*which)()) {
-  const Capture& capture = which();
-  const PacketDecoder decoder(Calibration::vlp16_default());
-  std::vector<Point> points;
-  points.reserve(capture.packets.size() * 384);
-  std::size_t decoded = 0;
-  for (auto _ : state) {
-    points.clear();
-    for (const auto& packet : capture.packets)
-      decoded += decoder.decode(packet, points).points;
-    benchmark::DoNotOptimize(points.data());
-    benchmark::ClobberMemory();
-  }
-  state.SetItemsProcessed(static_cast<std::int64_t>(decoded));
-  state.counters["packets/s"] =
-      benchmark::Counter(static_cast<double>(capture.packets.size()) * static_cast<double>(state.iterations()),
-                         benchmark::Counter::kIsRate);
-}
-BENCHMARK_CAPTURE(BM_DecodePackets, mrpt, mrpt_capture)->Name("vlp16/decode/mrpt")->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_DecodePackets, dual, dual_capture)->Name("vlp16/decode/dual")->Unit(benchmark::kMicrosecond);
-
-// Each build forced, where the processor has it (what the start-up timing compares).
-void BM_DecodeBuild(benchmark::State& state, const Capture& (*which)(), DecoderBuild build) {
-  if (build == DecoderBuild::kAvx2 && !decoder_calibration().avx2_available) {
+// PacketDecoder alone: bytes to points, output vector reused. `decode`: PacketDecoder::decode
+// (the build the start-up timing chose), or one build forced (decode_avx2 only where the
+// processor has AVX2).
+using DecodeFn = PacketDecoder::Result (PacketDecoder::*)(std::span<const std::uint8_t>, std::vector<Point>&) const;
+void BM_DecodePackets(benchmark::State& state, const Capture& (*which)(), DecodeFn decode) {
+  if (decode == &PacketDecoder::decode_avx2 && !decoder_calibration().avx2_available) {
     state.SkipWithError("this processor has no AVX2");
     return;
   }
@@ -86,24 +67,31 @@ void BM_DecodeBuild(benchmark::State& state, const Capture& (*which)(), DecoderB
   for (auto _ : state) {
     points.clear();
     for (const auto& packet : capture.packets)
-      decoded +=
-          (build == DecoderBuild::kAvx2 ? decoder.decode_avx2(packet, points) : decoder.decode_baseline(packet, points))
-              .points;
+      decoded += (decoder.*decode)(packet, points).points;
     benchmark::DoNotOptimize(points.data());
     benchmark::ClobberMemory();
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(decoded));
+  state.counters["packets/s"] =
+      benchmark::Counter(static_cast<double>(capture.packets.size()) * static_cast<double>(state.iterations()),
+                         benchmark::Counter::kIsRate);
 }
-BENCHMARK_CAPTURE(BM_DecodeBuild, mrpt_baseline, mrpt_capture, DecoderBuild::kBaseline)
+BENCHMARK_CAPTURE(BM_DecodePackets, mrpt, mrpt_capture, &PacketDecoder::decode)
+    ->Name("vlp16/decode/mrpt")
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_DecodePackets, dual, dual_capture, &PacketDecoder::decode)
+    ->Name("vlp16/decode/dual")
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_DecodePackets, mrpt_baseline, mrpt_capture, &PacketDecoder::decode_baseline)
     ->Name("vlp16/decode/mrpt/baseline")
     ->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_DecodeBuild, mrpt_avx2, mrpt_capture, DecoderBuild::kAvx2)
+BENCHMARK_CAPTURE(BM_DecodePackets, mrpt_avx2, mrpt_capture, &PacketDecoder::decode_avx2)
     ->Name("vlp16/decode/mrpt/avx2")
     ->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_DecodeBuild, dual_baseline, dual_capture, DecoderBuild::kBaseline)
+BENCHMARK_CAPTURE(BM_DecodePackets, dual_baseline, dual_capture, &PacketDecoder::decode_baseline)
     ->Name("vlp16/decode/dual/baseline")
     ->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_DecodeBuild, dual_avx2, dual_capture, DecoderBuild::kAvx2)
+BENCHMARK_CAPTURE(BM_DecodePackets, dual_avx2, dual_capture, &PacketDecoder::decode_avx2)
     ->Name("vlp16/decode/dual/avx2")
     ->Unit(benchmark::kMicrosecond);
 

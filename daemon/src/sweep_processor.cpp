@@ -65,9 +65,10 @@ __attribute__((target("avx"))) inline __m128 transformed_row(const Eigen::Isomet
 // copy_for_filter then roi::transform_points in one pass, four points at a time: their x, y
 // and z side by side (a transpose of the records), each coordinate's products and sums in
 // transform_points' order, in doubles, without fused multiply-adds (none in this target), so
-// every coordinate rounds exactly as there.
-__attribute__((target("avx"))) void place_avx(const Eigen::Isometry3d& global_from_sensor,
-                                              std::span<const vlp16::Point> in, roi::PointXYZI* out) noexcept {
+// every coordinate rounds exactly as there. Places the whole fours and answers how many.
+__attribute__((target("avx"))) std::size_t place_fours_avx(const Eigen::Isometry3d& global_from_sensor,
+                                                           std::span<const vlp16::Point> in,
+                                                           roi::PointXYZI* out) noexcept {
   static_assert(offsetof(vlp16::Point, x) == 0 && offsetof(vlp16::Point, y) == 4 && offsetof(vlp16::Point, z) == 8 &&
                 sizeof(vlp16::Point) >= 16);
   std::size_t i = 0;
@@ -91,23 +92,20 @@ __attribute__((target("avx"))) void place_avx(const Eigen::Isometry3d& global_fr
     _mm_storeu_ps(&out[2].x, gz);
     _mm_storeu_ps(&out[3].x, gi);
   }
-  const std::span<const vlp16::Point> rest = in.subspan(i);
-  copy_for_filter(rest, out);
-  const std::span<roi::PointXYZI> tail(out, rest.size());
-  roi::transform_points(global_from_sensor, tail, tail);
+  return i;
 }
 #endif
 
-// Points of one pose into the global frame, as the filter takes them.
+// Points of one pose into the global frame, as the filter takes them: whole fours in one AVX
+// pass where the processor has it, the rest copied and transformed.
 void place(const Eigen::Isometry3d& global_from_sensor, std::span<const vlp16::Point> in, roi::PointXYZI* out) {
+  std::size_t done = 0;
 #if defined(__x86_64__) || defined(__i386__)
-  if (__builtin_cpu_supports("avx")) {
-    place_avx(global_from_sensor, in, out);
-    return;
-  }
+  if (__builtin_cpu_supports("avx")) done = place_fours_avx(global_from_sensor, in, out);
 #endif
-  copy_for_filter(in, out);
-  const std::span<roi::PointXYZI> placed(out, in.size());
+  const std::span<const vlp16::Point> rest = in.subspan(done);
+  copy_for_filter(rest, out + done);
+  const std::span<roi::PointXYZI> placed(out + done, rest.size());
   roi::transform_points(global_from_sensor, placed, placed);
 }
 

@@ -105,20 +105,18 @@ TEST(Sweep, TakeExchangesThePointArraysAndCopiesTheHeader) {
   built.time_offset_ns = {11, 12};
   built.point_index = {13, 14};
   const Sweep expected = built;
-  const std::vector<const void*> built_arrays{built.x.data(),
-                                              built.y.data(),
-                                              built.z.data(),
-                                              built.intensity.data(),
-                                              built.ring.data(),
-                                              built.return_type.data(),
-                                              built.time_offset_ns.data()};
-  const std::vector<const void*> slot_arrays{slot.x.data(),
-                                             slot.y.data(),
-                                             slot.z.data(),
-                                             slot.intensity.data(),
-                                             slot.ring.data(),
-                                             slot.return_type.data(),
-                                             slot.time_offset_ns.data()};
+  // Where each of the seven point arrays lives.
+  const auto arrays = [](const Sweep& s) {
+    return std::vector<const void*>{s.x.data(),
+                                    s.y.data(),
+                                    s.z.data(),
+                                    s.intensity.data(),
+                                    s.ring.data(),
+                                    s.return_type.data(),
+                                    s.time_offset_ns.data()};
+  };
+  const std::vector<const void*> built_arrays = arrays(built);
+  const std::vector<const void*> slot_arrays = arrays(slot);
 
   slot.take(built);
 
@@ -136,12 +134,8 @@ TEST(Sweep, TakeExchangesThePointArraysAndCopiesTheHeader) {
   EXPECT_EQ(slot.point_index, expected.point_index);
   // Exchanged, not copied: the points live where they were built, the slot's arrays (reserved
   // alike) are the processor's for the next sweep.
-  EXPECT_EQ((std::vector<const void*>{slot.x.data(), slot.y.data(), slot.z.data(), slot.intensity.data(),
-                                      slot.ring.data(), slot.return_type.data(), slot.time_offset_ns.data()}),
-            built_arrays);
-  EXPECT_EQ((std::vector<const void*>{built.x.data(), built.y.data(), built.z.data(), built.intensity.data(),
-                                      built.ring.data(), built.return_type.data(), built.time_offset_ns.data()}),
-            slot_arrays);
+  EXPECT_EQ(arrays(slot), built_arrays);
+  EXPECT_EQ(arrays(built), slot_arrays);
   EXPECT_GE(built.x.capacity(), 64U);
   EXPECT_EQ(built.index, 41U);  // the processor's header is left as it was
 }
