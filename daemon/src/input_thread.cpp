@@ -34,6 +34,23 @@ bool wake_now(const inputs::InputItem& item, std::uint16_t cut_cdeg, std::uint16
          (vlp16::may_complete_frame(item.bytes, cut_cdeg) || vlp16::may_complete_frame(item.bytes, drain_cdeg));
 }
 
+// Decodes a LiDAR data packet ahead into the lane's ring of decoded packets, so that the
+// processing thread, on the other core, only copies its points. Answers whether it did: not for
+// other items, nor for a packet the decoder does not take (the processing thread counts and
+// says why), nor when that ring is full (the processing thread then decodes it itself: the same
+// points either way).
+bool decode_ahead(const Pipeline& pipeline, InputLane& lane, const InputSlot& slot) {
+  if (slot.stream != inputs::Stream::kLidarData || pipeline.lidar_decoder == nullptr) return false;
+  const std::span<const std::uint8_t> packet(slot.bytes.data(), slot.size);
+  if (vlp16::validate_data_packet(packet) != vlp16::PacketError::kNone) return false;
+  if (!lane.decoded) lane.decoded = std::make_unique<Ring<vlp16::DecodedPacket>>(kDecodeAhead);
+  return lane.decoded->try_push([&](vlp16::DecodedPacket& d) {
+    d.tag = slot.seq;
+    d.points.clear();
+    d.result = pipeline.lidar_decoder->decode(packet, d.points);
+  });
+}
+
 }  // namespace
 
 void input_loop(Pipeline& pipeline, InputLane& lane) {
@@ -113,15 +130,24 @@ void input_loop(Pipeline& pipeline, InputLane& lane) {
         slot.stream = item.stream;
         slot.size = static_cast<std::uint16_t>(piece.size());
         std::copy(piece.begin(), piece.end(), slot.bytes.begin());
-        slot.arrival_ns = steady_ns();
+        slot.arrival_ns = steady_ns();  // before decoding: the latency figures include it
         slot.seq = pipeline.sequence.fetch_add(1, std::memory_order_relaxed);
+        slot.decoded = decode_ahead(pipeline, lane, slot);
       };
       const bool pushed = pipeline.exact ? ring.push_wait(fill, pipeline.stop, on_full) : ring.try_push(fill);
       if (!pushed) lane.ring_drops[static_cast<std::size_t>(item.stream)].fetch_add(1, std::memory_order_relaxed);
     } while (!rest.empty());
     if ((++items & 255U) == 0) copy_counters(source, lane);  // current under constant traffic
     if (unnotified++ == 0) held_since_ns = steady_ns();
-    if (unnotified >= max_batch || wake_now(item, cut_cdeg, drain_cdeg) ||
+    // An as-fast replay's processing thread that waits for input is woken at once: it would
+    // idle for the batch (the fence orders the push before the look at its flag, as the
+    // processing thread orders its flag before its look at the rings).
+    bool waits = false;
+    if (pipeline.exact) {
+      std::atomic_thread_fence(std::memory_order_seq_cst);
+      waits = pipeline.processing_waits.load(std::memory_order_relaxed);
+    }
+    if (waits || unnotified >= max_batch || wake_now(item, cut_cdeg, drain_cdeg) ||
         (!source.ready() && steady_ns() - held_since_ns >= kMaxHold_ns)) {
       pipeline.process_wake.notify();
       unnotified = 0;

@@ -22,6 +22,7 @@
 #include "trajroi/daemon/sweep_processor.hpp"
 #include "trajroi/inputs/input_source.hpp"
 #include "trajroi/transport/spsc_ring.hpp"
+#include "trajroi/vlp16/stream_decoder.hpp"
 
 namespace trajroi::daemon {
 
@@ -30,6 +31,9 @@ using Ring = transport::SpscRing<T>;
 
 inline constexpr std::size_t kMaxItemBytes = inputs::kMaxDatagramBytes;  // a slot holds any datagram
 inline constexpr int kIdleWait_ms = 100;                                 // every loop wakes at least this often
+// LiDAR data packets an input thread decodes ahead of the processing thread at most (its ring
+// of decoded packets, 1.4 MB): more than the batch it holds before waking that thread.
+inline constexpr std::size_t kDecodeAhead = 128;
 
 // CLOCK_MONOTONIC and the calling thread's CPU time, ns.
 [[nodiscard]] std::int64_t steady_ns() noexcept;
@@ -69,6 +73,7 @@ struct InputSlot {
   std::int64_t arrival_ns = 0;  // CLOCK_MONOTONIC when it entered the ring (latency)
   inputs::Stream stream = inputs::Stream::kLidarData;
   std::uint16_t size = 0;
+  bool decoded = false;  // a LiDAR data packet whose points wait in its lane's `decoded` ring
   std::array<std::uint8_t, kMaxItemBytes> bytes{};
 };
 
@@ -76,6 +81,10 @@ struct InputSlot {
 struct InputLane {
   std::unique_ptr<inputs::InputSource> source;
   std::unique_ptr<Ring<InputSlot>> ring;
+  // The points of the LiDAR data packets in `ring` that the input thread decoded ahead, in the
+  // same order (made by that thread at its first data packet, when the pipeline has a
+  // lidar_decoder).
+  std::unique_ptr<Ring<vlp16::DecodedPacket>> decoded;
   std::string thread_name;  // "trajroid-lidar", …
   ThreadConfig thread;
   std::atomic<bool> done{false};
@@ -106,6 +115,9 @@ struct Pipeline {
 
   const DaemonConfig& config;
   const bool exact;
+  // The processor's packet decoder (SweepProcessor::packet_decoder()), set before the threads
+  // start: the input threads decode LiDAR data packets ahead with it, on their own core.
+  const vlp16::PacketDecoder* lidar_decoder = nullptr;
   std::atomic<bool> stop{false};
   std::atomic<std::uint64_t> sequence{0};
   EventFd process_wake, publish_wake, record_wake, main_wake;
@@ -116,6 +128,9 @@ struct Pipeline {
   Ring<TrajectoryItem> trajectories_out;    // processing → publisher (to free)
   std::unique_ptr<Ring<InputSlot>> record;  // processing → recorder, when recording
   std::atomic<bool> processing_done{false}, publishing_done{false};
+  // The processing thread is about to wait for input, or waits: an as-fast-as-possible
+  // replay's reader then wakes it at once instead of at the end of its batch.
+  std::atomic<bool> processing_waits{false};
   std::atomic<std::uint64_t> processing_beat{0}, publishing_beat{0};
   // CPU time of each kind of thread, added as each ends (for the summary).
   std::atomic<std::int64_t> cpu_sources_ns{0}, cpu_processing_ns{0}, cpu_publishing_ns{0};

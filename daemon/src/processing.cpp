@@ -78,8 +78,13 @@ class Processing {
         const std::int64_t start = steady_ns();
         sink_.packet_started(start);
         processor_.set_input_arrival(item.arrival_ns);
+        // A data packet decoded ahead by its input thread: its points are first in that lane's
+        // ring of decoded packets (the tag is a guard: never another packet's points).
+        vlp16::DecodedPacket* ahead = item.decoded ? lane.decoded->front() : nullptr;
         processor_.lidar_datagram(item.stream == inputs::Stream::kLidarData ? LidarPort::kData : LidarPort::kPosition,
-                                  bytes, item.receive_ns, sink_);
+                                  bytes, item.receive_ns, sink_,
+                                  ahead != nullptr && ahead->tag == item.seq ? ahead : nullptr);
+        if (ahead != nullptr) lane.decoded->release();
         sink_.packet_done(steady_ns());
         break;
       }
@@ -163,7 +168,12 @@ class Processing {
         processor_.flush(sink_);
         break;
       }
-      if (handled == 0) pipeline_.process_wake.wait(kIdleWait_ms);
+      if (handled == 0) {
+        pipeline_.processing_waits.store(true, std::memory_order_relaxed);
+        std::atomic_thread_fence(std::memory_order_seq_cst);  // paired with the reader's (input_thread.cpp)
+        if (pipeline_.inputs_empty()) pipeline_.process_wake.wait(kIdleWait_ms);
+        pipeline_.processing_waits.store(false, std::memory_order_relaxed);
+      }
     }
     snapshot(true);
   }

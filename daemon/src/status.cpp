@@ -79,6 +79,7 @@ struct Names {
     set(C::kSweepsPointsTruncated, "sweeps.points_truncated");
     set(C::kTrajectorySwaps, "trajectory.swaps");
     set(C::kTrajectoryProjectionReacquired, "trajectory.projection_reacquired");
+    set(C::kLidarDecodedAhead, "lidar.decoded_ahead");
   }
 };
 
@@ -196,6 +197,7 @@ void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64
   s[C::kSweepsPointsTruncated] = p.counters().points_truncated;
   s[C::kTrajectorySwaps] = p.counters().trajectory_swaps;
   s[C::kTrajectoryProjectionReacquired] = p.counters().projection_reacquired;
+  s[C::kLidarDecodedAhead] = l.decoded_ahead;
 }
 
 }  // namespace trajroi::daemon

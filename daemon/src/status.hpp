@@ -73,6 +73,7 @@ enum class Counter : std::uint16_t {
   kSweepsPointsTruncated,
   kTrajectorySwaps,
   kTrajectoryProjectionReacquired,
+  kLidarDecodedAhead,
   kCount
 };
 inline constexpr std::size_t kCounterCount = static_cast<std::size_t>(Counter::kCount);

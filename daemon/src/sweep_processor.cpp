@@ -221,13 +221,13 @@ roi::ScanCalibration SweepProcessor::calibrate_scan() const {
 }
 
 void SweepProcessor::lidar_datagram(LidarPort port, std::span<const std::uint8_t> payload, std::int64_t receive_ns,
-                                    SweepSink& sink) {
+                                    SweepSink& sink, const vlp16::DecodedPacket* decoded) {
   if (port == LidarPort::kPosition) {
     decoder_.on_position_packet(payload);
     return;
   }
   FrameAdapter adapter(*this, sink);
-  decoder_.on_data_packet(payload, receive_ns, adapter);
+  decoder_.on_data_packet(payload, receive_ns, adapter, decoded);
 }
 
 double SweepProcessor::host_minus_gnss_utc_s() const noexcept {

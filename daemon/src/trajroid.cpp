@@ -32,7 +32,7 @@ namespace {
 // An as-fast-as-possible replay waits on a full ring instead of dropping, so its ring only
 // covers the reader's pauses: this many packets (≈ 2 ms of processing) at most, not the live
 // depth (seconds of packets, 5 MB written at start-up).
-constexpr std::size_t kExactReplayRing = 512;
+constexpr std::size_t kExactReplayRing = kDecodeAhead;
 
 // gnss.configure / imu.configure: the receiver's output set each time its device opens; the
 // outcome (and each refused step) is said with the open.
@@ -148,6 +148,7 @@ int run_pipeline(Pipeline& pipeline, SweepProcessor& processor, Outlet& outlet, 
                  bool signals) {
   const std::int64_t start_ns = steady_ns();
   const int sfd = signals ? block_signals() : -1;
+  pipeline.lidar_decoder = &processor.packet_decoder();  // the input threads decode ahead with it
   Reloader reloader(TrajectorySource::from(pipeline.config), pipeline.publish_wake);
   Publisher publisher(pipeline, outlet, &reloader, options.replay.has_value());
   ProcessingOptions processing;

@@ -8,6 +8,7 @@
 #include <spdlog/sinks/ringbuffer_sink.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -205,7 +206,8 @@ TEST(Pipeline, ThreeFakeInputLanesThroughTheThreadsGiveTheProcessorsOwnSweeps) {
 TEST(Pipeline, OneRecordedLaneIsExactlyTheProcessorsOutput) {
   const DaemonConfig config = trajroi::daemon::load_daemon_config(corridor_run() / "trajroid.yaml");
   Pipeline pipeline(config, /*exact=*/true, /*record=*/false);
-  pipeline.add_input(std::make_unique<FakeInput>(run_items({})), 16, "test-replay", {});
+  const std::vector<Item> items = run_items({});
+  pipeline.add_input(std::make_unique<FakeInput>(items), 16, "test-replay", {});
   SweepProcessor processor(config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
   FakeOutlet outlet;
   EXPECT_EQ(trajroi::daemon::run_pipeline(pipeline, processor, outlet, {}, /*signals=*/false), 0);
@@ -215,6 +217,13 @@ TEST(Pipeline, OneRecordedLaneIsExactlyTheProcessorsOutput) {
     published[m.sweep_index] = static_cast<std::size_t>(m.num_points);
   }
   EXPECT_EQ(published, reference_kept(config));
+  // The input thread decoded every data packet ahead (its ring of decoded packets is deeper
+  // than this lane's ring of 16): the processing thread only took their points.
+  const auto statuses = outlet.messages(config.lcm.status);
+  ASSERT_FALSE(statuses.empty());
+  const auto data_packets = static_cast<std::int64_t>(
+      std::count_if(items.begin(), items.end(), [](const Item& i) { return i.stream == inputs::Stream::kLidarData; }));
+  EXPECT_EQ(counter(decode<trajroi::status_t>(statuses.back()), "lidar.decoded_ahead"), data_packets);
 }
 
 // The evaluation (trajroi eval) runs the daemon's own pipeline: for the same run and the same

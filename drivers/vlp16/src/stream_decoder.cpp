@@ -56,8 +56,8 @@ StreamDecoder::StreamDecoder(const Calibration& calibration, StreamOptions optio
   carried_.reserve(kBlocks * kFiringsPerBlock * kLasers);
 }
 
-void StreamDecoder::on_data_packet(std::span<const std::uint8_t> payload, std::int64_t receive_time_ns,
-                                   FrameSink& sink) {
+void StreamDecoder::on_data_packet(std::span<const std::uint8_t> payload, std::int64_t receive_time_ns, FrameSink& sink,
+                                   const DecodedPacket* decoded) {
   ++counters_.data_packets;
   const PacketError error = validate_data_packet(payload);
   if (error != PacketError::kNone) {
@@ -68,9 +68,9 @@ void StreamDecoder::on_data_packet(std::span<const std::uint8_t> payload, std::i
   switch (model_.check(payload)) {
     case ModelCheck::Verdict::kVlp16:
       for (const HeldPacket& held : held_)
-        accept(held.bytes, held.receive_time_ns, sink);
+        accept(held.bytes, held.receive_time_ns, sink, nullptr);
       held_.clear();
-      accept(payload, receive_time_ns, sink);
+      accept(payload, receive_time_ns, sink, decoded);
       return;
     case ModelCheck::Verdict::kUndecided:
       if (held_.size() < ModelCheck::kMaxUndecided) {
@@ -120,7 +120,8 @@ std::int64_t StreamDecoder::packet_time_ns(std::uint32_t toh_us, std::int64_t re
   return by_receive;
 }
 
-void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t receive_time_ns, FrameSink& sink) {
+void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t receive_time_ns, FrameSink& sink,
+                           const DecodedPacket* decoded) {
   const auto mode = static_cast<ReturnMode>(return_mode_byte(packet));
   const bool dual = mode == ReturnMode::kDual;
   const std::size_t step = dual ? 2 : 1;
@@ -152,7 +153,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
         --frame_.lost_packets;
         --counters_.lost_packets;
       }
-      append_late(packet, anchor_time_ns_ + (unwrapped_toh_us_ + delta_us) * 1000, sink);
+      append_late(packet, anchor_time_ns_ + (unwrapped_toh_us_ + delta_us) * 1000, sink, decoded);
       return;
     }
     const auto delta = static_cast<double>(delta_us);
@@ -206,7 +207,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   // frame. The loop keeps its state in locals, written back around the rare end of a frame.
   std::vector<Point>& points = frame_.points;
   std::size_t i = points.size();
-  decode_onto_frame(packet);
+  decode_onto_frame(packet, decoded);
   std::int64_t end_time_ns = frame_.end_time_ns;
   double last_phase_deg = last_phase_deg_;
   bool have_phase = have_phase_;
@@ -272,8 +273,19 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   report_points(sink);
 }
 
-void StreamDecoder::decode_onto_frame(std::span<const std::uint8_t> packet) {
-  const PacketDecoder::Result r = decoder_.decode(packet, frame_.points);
+void StreamDecoder::decode_onto_frame(std::span<const std::uint8_t> packet, const DecodedPacket* decoded) {
+  std::vector<Point>& points = frame_.points;
+  PacketDecoder::Result r;
+  if (decoded != nullptr) {
+    // Grown as decode() grows it: rarely, by many packets at once.
+    constexpr std::size_t kPacketPoints = kBlocks * kFiringsPerBlock * kLasers;
+    if (points.capacity() - points.size() < kPacketPoints) points.reserve(points.size() + kPacketPoints * 64);
+    points.insert(points.end(), decoded->points.begin(), decoded->points.end());
+    r = decoded->result;
+    ++counters_.decoded_ahead;
+  } else {
+    r = decoder_.decode(packet, points);
+  }
   ++counters_.decoded_packets;
   counters_.points += r.points;
   counters_.no_return += r.no_return;
@@ -289,13 +301,14 @@ void StreamDecoder::report_points(FrameSink& sink) {
   }
 }
 
-void StreamDecoder::append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns, FrameSink& sink) {
+void StreamDecoder::append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns, FrameSink& sink,
+                                const DecodedPacket* decoded) {
   if (frame_.points.empty() || packet_time_ns < frame_.start_time_ns) {
     ++counters_.late_dropped;
     return;
   }
   const std::size_t first = frame_.points.size();
-  decode_onto_frame(packet);
+  decode_onto_frame(packet, decoded);
   ++frame_.packets;
   for (std::size_t i = first; i < frame_.points.size(); ++i) {
     Point& point = frame_.points[i];

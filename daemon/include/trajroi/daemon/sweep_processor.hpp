@@ -163,7 +163,13 @@ class SweepProcessor {
   // the first sweep.
   roi::ScanCalibration calibrate_scan() const;
 
-  void lidar_datagram(LidarPort port, std::span<const std::uint8_t> payload, std::int64_t receive_ns, SweepSink& sink);
+  // `decoded`: a data packet's points decoded ahead by packet_decoder() (vlp16::StreamDecoder::
+  // on_data_packet), or null.
+  void lidar_datagram(LidarPort port, std::span<const std::uint8_t> payload, std::int64_t receive_ns, SweepSink& sink,
+                      const vlp16::DecodedPacket* decoded = nullptr);
+  // The packet decoder the stream decodes with: const and stateless, for another thread to
+  // decode packets ahead.
+  [[nodiscard]] const vlp16::PacketDecoder& packet_decoder() const noexcept { return decoder_.decoder(); }
   void gnss_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) {
     pose_input_.gnss_bytes(bytes, receive_ns);
   }

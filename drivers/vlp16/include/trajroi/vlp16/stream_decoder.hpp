@@ -82,6 +82,7 @@ class FrameSink {
 struct StreamCounters {
   std::uint64_t data_packets = 0;  // handed to on_data_packet
   std::uint64_t decoded_packets = 0;
+  std::uint64_t decoded_ahead = 0;  // of those, decoded before they were handed over (DecodedPacket)
   std::array<std::uint64_t, kPacketErrorCount> rejected{};  // by PacketError (kNone unused)
   std::uint64_t lost_packets = 0;
   std::uint64_t out_of_order = 0;
@@ -116,12 +117,28 @@ struct StreamCounters {
 inline constexpr std::uint32_t kFrameEndMargin_cdeg = 100;
 [[nodiscard]] bool may_complete_frame(std::span<const std::uint8_t> packet, std::uint16_t cut_cdeg) noexcept;
 
+// A data packet's points as PacketDecoder::decode() gave them, decoded ahead of the stream
+// (by the thread that received the packet, while the stream's own thread works on earlier
+// ones). `tag` ties it to its packet (the caller's sequence number).
+struct DecodedPacket {
+  std::uint64_t tag = 0;
+  PacketDecoder::Result result;
+  std::vector<Point> points;  // reserved for a whole packet: decoding into it never allocates
+  DecodedPacket() { points.reserve(kBlocks * kFiringsPerBlock * kLasers); }
+};
+
 class StreamDecoder {
  public:
   StreamDecoder(const Calibration& calibration, StreamOptions options);
 
-  // One port-2368 payload. May complete a frame (rarely two) into `sink`.
-  void on_data_packet(std::span<const std::uint8_t> payload, std::int64_t receive_time_ns, FrameSink& sink);
+  // One port-2368 payload. May complete a frame (rarely two) into `sink`. `decoded`: its
+  // points already decoded by decoder().decode() (the same points as decoding it here), or
+  // null.
+  void on_data_packet(std::span<const std::uint8_t> payload, std::int64_t receive_time_ns, FrameSink& sink,
+                      const DecodedPacket* decoded = nullptr);
+  // The packet decoder this stream decodes with; decode() is const and keeps no state, so
+  // another thread may decode packets ahead with it.
+  [[nodiscard]] const PacketDecoder& decoder() const noexcept { return decoder_; }
   // One port-8308 payload.
   void on_position_packet(std::span<const std::uint8_t> payload);
   // Delivers the frame in progress (partial), e.g. at the end of a capture.
@@ -141,10 +158,13 @@ class StreamDecoder {
   [[nodiscard]] const TopOfHourClock& utc_clock() const noexcept { return utc_clock_; }
 
  private:
-  void accept(std::span<const std::uint8_t> packet, std::int64_t receive_time_ns, FrameSink& sink);
-  // Appends the packet's points to the frame (time after the packet's first firing) and counts them.
-  void decode_onto_frame(std::span<const std::uint8_t> packet);
-  void append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns, FrameSink& sink);
+  void accept(std::span<const std::uint8_t> packet, std::int64_t receive_time_ns, FrameSink& sink,
+              const DecodedPacket* decoded);
+  // Appends the packet's points to the frame (time after the packet's first firing), decoded
+  // here or ahead, and counts them.
+  void decode_onto_frame(std::span<const std::uint8_t> packet, const DecodedPacket* decoded);
+  void append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns, FrameSink& sink,
+                   const DecodedPacket* decoded);
   std::int64_t packet_time_ns(std::uint32_t toh_us, std::int64_t receive_time_ns, double period_us);
   void finish_frame(FrameSink& sink, bool partial);
   void report_points(FrameSink& sink);
