@@ -41,6 +41,10 @@ bool wake_now(const inputs::InputItem& item, std::uint16_t cut_cdeg, std::uint16
 // points either way).
 bool decode_ahead(const Pipeline& pipeline, InputLane& lane, const InputSlot& slot) {
   if (slot.stream != inputs::Stream::kLidarData || pipeline.lidar_decoder == nullptr) return false;
+  // Only while the processing thread is behind (items wait in the ring): otherwise it decodes
+  // the packet itself, as at real time, where decoding ahead would only add the copy between
+  // the cores. The work goes to whichever core has room.
+  if (lane.ring->size() < kDecodeAheadBacklog) return false;
   const std::span<const std::uint8_t> packet(slot.bytes.data(), slot.size);
   if (vlp16::validate_data_packet(packet) != vlp16::PacketError::kNone) return false;
   if (!lane.decoded) lane.decoded = std::make_unique<Ring<vlp16::DecodedPacket>>(kDecodeAhead);
@@ -140,13 +144,8 @@ void input_loop(Pipeline& pipeline, InputLane& lane) {
     if ((++items & 255U) == 0) copy_counters(source, lane);  // current under constant traffic
     if (unnotified++ == 0) held_since_ns = steady_ns();
     // An as-fast replay's processing thread that waits for input is woken at once: it would
-    // idle for the batch (the fence orders the push before the look at its flag, as the
-    // processing thread orders its flag before its look at the rings).
-    bool waits = false;
-    if (pipeline.exact) {
-      std::atomic_thread_fence(std::memory_order_seq_cst);
-      waits = pipeline.processing_waits.load(std::memory_order_relaxed);
-    }
+    // idle for the batch. (A flag seen too late delays it to the batch's end, as before.)
+    const bool waits = pipeline.exact && pipeline.processing_waits.load();
     if (waits || unnotified >= max_batch || wake_now(item, cut_cdeg, drain_cdeg) ||
         (!source.ready() && steady_ns() - held_since_ns >= kMaxHold_ns)) {
       pipeline.process_wake.notify();

@@ -34,6 +34,8 @@ inline constexpr int kIdleWait_ms = 100;                                 // ever
 // LiDAR data packets an input thread decodes ahead of the processing thread at most (its ring
 // of decoded packets, 1.4 MB): more than the batch it holds before waking that thread.
 inline constexpr std::size_t kDecodeAhead = 128;
+// … once this many items wait in its ring.
+inline constexpr std::size_t kDecodeAheadBacklog = 16;
 
 // CLOCK_MONOTONIC and the calling thread's CPU time, ns.
 [[nodiscard]] std::int64_t steady_ns() noexcept;

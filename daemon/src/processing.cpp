@@ -169,10 +169,9 @@ class Processing {
         break;
       }
       if (handled == 0) {
-        pipeline_.processing_waits.store(true, std::memory_order_relaxed);
-        std::atomic_thread_fence(std::memory_order_seq_cst);  // paired with the reader's (input_thread.cpp)
+        pipeline_.processing_waits.store(true);  // seen by the readers (input_thread.cpp)
         if (pipeline_.inputs_empty()) pipeline_.process_wake.wait(kIdleWait_ms);
-        pipeline_.processing_waits.store(false, std::memory_order_relaxed);
+        pipeline_.processing_waits.store(false);
       }
     }
     snapshot(true);

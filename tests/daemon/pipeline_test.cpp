@@ -217,13 +217,15 @@ TEST(Pipeline, OneRecordedLaneIsExactlyTheProcessorsOutput) {
     published[m.sweep_index] = static_cast<std::size_t>(m.num_points);
   }
   EXPECT_EQ(published, reference_kept(config));
-  // The input thread decoded every data packet ahead (its ring of decoded packets is deeper
-  // than this lane's ring of 16): the processing thread only took their points.
+  // The input thread decoded data packets ahead while the processing thread was busy (the
+  // others that one decoded itself): the same sweeps either way.
   const auto statuses = outlet.messages(config.lcm.status);
   ASSERT_FALSE(statuses.empty());
   const auto data_packets = static_cast<std::int64_t>(
       std::count_if(items.begin(), items.end(), [](const Item& i) { return i.stream == inputs::Stream::kLidarData; }));
-  EXPECT_EQ(counter(decode<trajroi::status_t>(statuses.back()), "lidar.decoded_ahead"), data_packets);
+  const std::int64_t ahead = counter(decode<trajroi::status_t>(statuses.back()), "lidar.decoded_ahead");
+  EXPECT_GT(ahead, 0);
+  EXPECT_LE(ahead, data_packets);
 }
 
 // The evaluation (trajroi eval) runs the daemon's own pipeline: for the same run and the same
