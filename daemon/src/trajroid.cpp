@@ -136,9 +136,9 @@ void log_summary(const Pipeline& pipeline, const Publisher& publisher, std::int6
       wall_s, p.sweeps, p.sweeps_filtered, p.sweeps_without_pose, p.points_in, p.points_kept,
       p.points_in > 0 ? 100.0 * static_cast<double>(p.points_kept) / static_cast<double>(p.points_in) : 0.0,
       latency.quantile(0.5), latency.quantile(0.99), latency.count(), s.ring_drops(), s.lost_packets, s.decode_errors);
-  log::info("cpu: sources {:.3f} s ({}), processing {:.3f} s, publishing {:.3f} s",
+  log::info("cpu: sources {:.3f} s ({}; {} LiDAR packets decoded ahead), processing {:.3f} s, publishing {:.3f} s",
             static_cast<double>(pipeline.cpu_sources_ns.load()) * 1e-9, replay ? "replay reader" : "receive threads",
-            static_cast<double>(pipeline.cpu_processing_ns.load()) * 1e-9,
+            s[Counter::kLidarDecodedAhead], static_cast<double>(pipeline.cpu_processing_ns.load()) * 1e-9,
             static_cast<double>(pipeline.cpu_publishing_ns.load()) * 1e-9);
 }
 
