@@ -32,9 +32,9 @@ using Ring = transport::SpscRing<T>;
 inline constexpr std::size_t kMaxItemBytes = inputs::kMaxDatagramBytes;  // a slot holds any datagram
 inline constexpr int kIdleWait_ms = 100;                                 // every loop wakes at least this often
 // LiDAR data packets an input thread decodes ahead of the processing thread at most (its ring
-// of decoded packets, 1.4 MB): more than the batch it holds before waking that thread.
+// of decoded packets, 1.4 MB) …
 inline constexpr std::size_t kDecodeAhead = 128;
-// … once this many items wait in its ring.
+// … while that thread is busy and at least this many items wait in its ring.
 inline constexpr std::size_t kDecodeAheadBacklog = 16;
 
 // CLOCK_MONOTONIC and the calling thread's CPU time, ns.
@@ -84,7 +84,7 @@ struct InputLane {
   std::unique_ptr<inputs::InputSource> source;
   std::unique_ptr<Ring<InputSlot>> ring;
   // The points of the LiDAR data packets in `ring` that the input thread decoded ahead, in the
-  // same order (made by that thread at its first data packet, when the pipeline has a
+  // same order (made by that thread the first time it decodes ahead, when the pipeline has a
   // lidar_decoder).
   std::unique_ptr<Ring<vlp16::DecodedPacket>> decoded;
   std::string thread_name;  // "trajroid-lidar", …

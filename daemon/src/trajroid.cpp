@@ -30,8 +30,8 @@ namespace trajroi::daemon {
 namespace {
 
 // An as-fast-as-possible replay waits on a full ring instead of dropping, so its ring only
-// covers the reader's pauses: this many packets (≈ 2 ms of processing) at most, not the live
-// depth (seconds of packets, 5 MB written at start-up).
+// covers the reader's pauses: as many packets as it may decode ahead (≈ 0.5 ms of processing)
+// at most, not the live depth (seconds of packets, 5 MB written at start-up).
 constexpr std::size_t kExactReplayRing = kDecodeAhead;
 
 // gnss.configure / imu.configure: the receiver's output set each time its device opens; the
