@@ -45,8 +45,8 @@ bool decode_ahead(const Pipeline& pipeline, InputLane& lane, const InputSlot& sl
   // thread holds back while it sleeps do not count): otherwise it decodes the packet itself, as
   // at real time, where decoding ahead would only add the copy between the cores. The work goes
   // to whichever core has room.
-  if (pipeline.processing_waits.load(std::memory_order_relaxed) || lane.ring->size() < kDecodeAheadBacklog)
-    return false;
+  const std::size_t backlog = std::min(kDecodeAheadBacklog, lane.ring->capacity() / 4);
+  if (pipeline.processing_waits.load(std::memory_order_relaxed) || lane.ring->size() < backlog) return false;
   const std::span<const std::uint8_t> packet(slot.bytes.data(), slot.size);
   if (vlp16::validate_data_packet(packet) != vlp16::PacketError::kNone) return false;
   if (!lane.decoded) lane.decoded = std::make_unique<Ring<vlp16::DecodedPacket>>(kDecodeAhead);

@@ -34,7 +34,8 @@ inline constexpr int kIdleWait_ms = 100;                                 // ever
 // LiDAR data packets an input thread decodes ahead of the processing thread at most (its ring
 // of decoded packets, 1.4 MB) …
 inline constexpr std::size_t kDecodeAhead = 128;
-// … while that thread is busy and at least this many items wait in its ring.
+// … while that thread is busy and at least this many items (a quarter of a smaller ring) wait
+// in its ring.
 inline constexpr std::size_t kDecodeAheadBacklog = 16;
 
 // CLOCK_MONOTONIC and the calling thread's CPU time, ns.
