@@ -221,7 +221,7 @@ __attribute__((always_inline)) inline PacketDecoder::Result PacketDecoder::decod
   const std::size_t step = dual ? 2 : 1;  // blocks per firing
   const ReturnType single_type =
       mode == static_cast<std::uint8_t>(ReturnMode::kLast) ? ReturnType::kLast : ReturnType::kStrongest;
-  if (out.capacity() - out.size() < kBlocks * kChannels) out.reserve(out.size() + kBlocks * kChannels * 64);
+  reserve_packet_room(out);
   const double min_range = options_.min_range_m;
   const double max_range = options_.max_range_m;
   Directions d;
@@ -357,7 +357,7 @@ DecoderCalibration calibrate_decoder(const char* forced) {
   const auto strongest = calibration_packets(ReturnMode::kStrongest);
   packets.insert(packets.end(), strongest.begin(), strongest.end());
   std::vector<Point> points;
-  points.reserve(packets.size() * kBlocks * kFiringsPerBlock * kLasers);
+  points.reserve(packets.size() * kPointsPerPacket);
   const auto time =
       [&](PacketDecoder::Result (PacketDecoder::*build)(std::span<const std::uint8_t>, std::vector<Point>&) const) {
         double fastest = std::numeric_limits<double>::infinity();

@@ -9,7 +9,7 @@ namespace {
 
 constexpr double kLossFactor = 1.5;  // a step beyond 1.5 expected ones means packets are missing
 // Points reserved for a frame: a dual-return sweep at 5 Hz is about 300 packets of up to 384.
-constexpr std::size_t kFrameReserve = 300 * kBlocks * kFiringsPerBlock * kLasers;
+constexpr std::size_t kFrameReserve = 300 * kPointsPerPacket;
 
 // Packets missing in a step of `observed` where `expected` was due, at least one.
 std::uint32_t missing(double observed, double expected) noexcept {
@@ -53,7 +53,7 @@ StreamDecoder::StreamDecoder(const Calibration& calibration, StreamOptions optio
   options_.cut_azimuth_deg = wrapped_deg(options_.cut_azimuth_deg);
   held_.reserve(ModelCheck::kMaxUndecided);
   frame_.points.reserve(kFrameReserve);
-  carried_.reserve(kBlocks * kFiringsPerBlock * kLasers);
+  carried_.reserve(kPointsPerPacket);
 }
 
 void StreamDecoder::on_data_packet(std::span<const std::uint8_t> payload, std::int64_t receive_time_ns, FrameSink& sink,
@@ -277,9 +277,7 @@ void StreamDecoder::decode_onto_frame(std::span<const std::uint8_t> packet, cons
   std::vector<Point>& points = frame_.points;
   PacketDecoder::Result r;
   if (decoded != nullptr) {
-    // Grown as decode() grows it: rarely, by many packets at once.
-    constexpr std::size_t kPacketPoints = kBlocks * kFiringsPerBlock * kLasers;
-    if (points.capacity() - points.size() < kPacketPoints) points.reserve(points.size() + kPacketPoints * 64);
+    reserve_packet_room(points);  // as decode() grows it
     points.insert(points.end(), decoded->points.begin(), decoded->points.end());
     r = decoded->result;
     ++counters_.decoded_ahead;

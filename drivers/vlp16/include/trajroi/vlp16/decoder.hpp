@@ -105,6 +105,12 @@ struct DecoderCalibration {
 // "baseline (no AVX2)".
 [[nodiscard]] std::string describe(const DecoderCalibration& calibration);
 
+// Room in `out` for one more packet's points, grown rarely (by 64 packets' worth at a time):
+// decode() and the stream decoder's points decoded ahead grow a frame alike.
+inline void reserve_packet_room(std::vector<Point>& out) {
+  if (out.capacity() - out.size() < kPointsPerPacket) out.reserve(out.size() + kPointsPerPacket * 64);
+}
+
 class PacketDecoder {
  public:
   explicit PacketDecoder(const Calibration& calibration, DecodeOptions options = {});

@@ -124,7 +124,7 @@ struct DecodedPacket {
   std::uint64_t tag = 0;
   PacketDecoder::Result result;
   std::vector<Point> points;  // reserved for a whole packet: decoding into it never allocates
-  DecodedPacket() { points.reserve(kBlocks * kFiringsPerBlock * kLasers); }
+  DecodedPacket() { points.reserve(kPointsPerPacket); }
 };
 
 class StreamDecoder {
