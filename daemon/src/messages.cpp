@@ -5,6 +5,10 @@
 #include <cstring>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "trajroi/pose/attitude.hpp"
 
 namespace trajroi::daemon {
@@ -29,16 +33,30 @@ void store_be32(std::uint8_t* p, std::uint32_t v) noexcept {
   std::memcpy(p, &v, sizeof v);
 }
 
-// LCM's big-endian 32-bit elements (float bits as they are), in a loop the compiler vectorizes.
+// LCM's big-endian 32-bit elements (float bits as they are). Four at a time in SSE2, which
+// every x86-64 has: GCC does not vectorise a byte swap for baseline x86-64, and with the
+// arrays' ends read through the vector (an uint8_t store may alias them) the plain loop also
+// reloaded them at every element; it was 7 % of an as-fast replay's CPU.
 template <typename T, typename Allocator>
 std::uint8_t* store_be32_array(std::uint8_t* out, const std::vector<T, Allocator>& values) noexcept {
   static_assert(sizeof(T) == sizeof(std::uint32_t));
-  for (std::size_t i = 0; i < values.size(); ++i) {
+  const T* const in = values.data();
+  const std::size_t n = values.size();
+  std::size_t i = 0;
+#if defined(__SSE2__)
+  for (; i + 4 <= n; i += 4) {
+    __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(in + i));
+    v = _mm_or_si128(_mm_slli_epi16(v, 8), _mm_srli_epi16(v, 8));  // the bytes of each half swapped
+    v = _mm_shufflehi_epi16(_mm_shufflelo_epi16(v, 0xB1), 0xB1);   // then the halves
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 4 * i), v);
+  }
+#endif
+  for (; i < n; ++i) {
     std::uint32_t v;
-    std::memcpy(&v, &values[i], sizeof v);
+    std::memcpy(&v, in + i, sizeof v);
     store_be32(out + 4 * i, v);
   }
-  return out + 4 * values.size();
+  return out + 4 * n;
 }
 
 // Every field of points_t but the points.
