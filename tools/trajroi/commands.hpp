@@ -14,6 +14,7 @@ void add_render_command(CLI::App& app);
 void add_watch_command(CLI::App& app);      // listens to trajroid over LCM
 void add_configure_command(CLI::App& app);  // trajroi configure gnss|imu
 void add_feed_command(CLI::App& app);       // plays a run folder into a live trajroid
+void add_machine_command(CLI::App& app);    // how steadily this machine gives a thread its CPU
 // keyframes, sequential, accumulated under `eval`.
 void add_scenario_eval_commands(CLI::App& eval_cmd);
 
