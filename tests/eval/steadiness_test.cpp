@@ -22,7 +22,8 @@ std::vector<PieceTiming> series(double seconds, double every_s, double full_us, 
 }
 
 TEST(Steadiness, ASteadyMachineHasNoSpell) {
-  const auto v = series(10.0, 0.005, 50.0, [](double t) { return 1.0 + 0.2 * ((static_cast<int>(t * 1000) % 7) / 7.0); });
+  const auto v =
+      series(10.0, 0.005, 50.0, [](double t) { return 1.0 + 0.2 * ((static_cast<int>(t * 1000) % 7) / 7.0); });
   const auto s = find_slow_spells(v);
   EXPECT_EQ(s.pieces, v.size());
   EXPECT_NEAR(s.full_speed_us, 50.0, 1.5);

@@ -177,3 +177,37 @@ TEST_F(Cli, LidarDumpRejectsAMissingFileAndABadCalibration) {
 }
 
 }  // namespace
+
+// trajroi machine: one line per core with its pieces and spells, the machine's summary; the
+// brief form three numbers; bad settings a clear error and exit code 2. (Whether this machine
+// has slow spells is its own affair: only the form and the counts are checked.)
+TEST_F(Cli, MachineReportsEveryCoreAndRefusesBadSettings) {
+  const CommandResult r = run("machine --seconds 0.5 --every-ms 5 --piece-us 20 --priority 0");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("SCHED_OTHER"), std::string::npos) << r.out;
+  const auto cores = static_cast<std::size_t>(sysconf(_SC_NPROCESSORS_ONLN));
+  std::size_t lines = 0;
+  for (std::size_t at = r.out.find("\ncpu "); at != std::string::npos; at = r.out.find("\ncpu ", at + 1))
+    ++lines;
+  EXPECT_GE(lines, 1U);
+  EXPECT_LE(lines, cores);
+  EXPECT_NE(r.out.find(" pieces, full speed "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("machine: longest slow spell "), std::string::npos) << r.out;
+
+  const CommandResult brief = run("machine --seconds 0.3 --priority 0 --brief");
+  ASSERT_EQ(brief.exit_code, 0) << brief.err;
+  std::istringstream fields(brief.out);
+  double longest_ms = -1.0;
+  double worst = -1.0;
+  double slow_ms = -1.0;
+  ASSERT_TRUE(fields >> longest_ms >> worst >> slow_ms) << brief.out;
+  EXPECT_GE(longest_ms, 0.0);
+  EXPECT_LE(longest_ms, slow_ms + 1e-9);
+  EXPECT_TRUE(worst == 0.0 || worst > 2.0) << "a spell is over 2x full speed: " << brief.out;
+
+  for (const char* bad : {"--seconds 0", "--every-ms -1", "--piece-us 6000 --every-ms 5"}) {
+    const CommandResult b = run(std::string("machine ") + bad);
+    EXPECT_EQ(b.exit_code, 2) << bad;
+    EXPECT_NE(b.err.find("must be positive"), std::string::npos) << bad << ": " << b.err;
+  }
+}

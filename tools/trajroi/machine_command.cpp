@@ -94,8 +94,9 @@ void time_pieces(Timer& timer, const MachineOptions& o, long steps, double start
 
 int run_machine(const MachineOptions& o) {
   if (!(o.seconds > 0.0) || !(o.every_ms > 0.0) || !(o.piece_us > 0.0) || o.piece_us >= o.every_ms * 1e3) {
-    std::fprintf(stderr, "trajroi machine: --seconds, --every-ms and --piece-us must be positive, the piece shorter "
-                         "than the interval\n");
+    std::fprintf(stderr,
+                 "trajroi machine: --seconds, --every-ms and --piece-us must be positive, the piece shorter "
+                 "than the interval\n");
     return 2;
   }
   cpu_set_t allowed;
@@ -130,18 +131,21 @@ int run_machine(const MachineOptions& o) {
     return 0;
   }
   const bool fifo = std::all_of(timers.begin(), timers.end(), [](const Timer& t) { return t.fifo; });
-  std::printf("machine: %s; %zu timing threads (one per core, %s), a %.0f µs piece of arithmetic every %.1f ms for "
-              "%.0f s\n",
-              roi::describe_machine().c_str(), timers.size(),
-              fifo ? ("SCHED_FIFO " + std::to_string(o.priority)).c_str()
-                   : "SCHED_OTHER: could not raise the priority, so this machine's own threads count too",
-              o.piece_us, o.every_ms, o.seconds);
+  std::printf(
+      "machine: %s; %zu timing threads (one per core, %s), a %.0f µs piece of arithmetic every %.1f ms for "
+      "%g s\n",
+      roi::describe_machine().c_str(), timers.size(),
+      fifo              ? ("SCHED_FIFO " + std::to_string(o.priority)).c_str()
+      : o.priority <= 0 ? "SCHED_OTHER as asked: this machine's own threads count too"
+                        : "SCHED_OTHER: could not raise the priority, so this machine's own threads count too",
+      o.piece_us, o.every_ms, o.seconds);
   for (std::size_t i = 0; i < timers.size(); ++i) {
     const eval::Steadiness& s = found[i];
-    std::printf("cpu %zu: %zu pieces, full speed %.1f µs, median %.1f µs; %zu slow spells (over 2x full speed), longest "
-                "%.1f ms, worst %.1fx, %.1f ms slow in all\n",
-                timers[i].cpu, s.pieces, s.full_speed_us, s.median_us, s.spells.size(), s.longest_ms(),
-                s.worst_factor(), s.slow_ms());
+    std::printf(
+        "cpu %zu: %zu pieces, full speed %.1f µs, median %.1f µs; %zu slow spells (over 2x full speed), longest "
+        "%.1f ms, worst %.1fx, %.1f ms slow in all\n",
+        timers[i].cpu, s.pieces, s.full_speed_us, s.median_us, s.spells.size(), s.longest_ms(), s.worst_factor(),
+        s.slow_ms());
     int shown = 0;
     for (const eval::SlowSpell& spell : s.spells) {
       if (spell.end_s - spell.start_s < 0.005 || ++shown > 10) continue;
@@ -158,8 +162,9 @@ int run_machine(const MachineOptions& o) {
 void add_machine_command(CLI::App& app) {
   auto opts = std::make_shared<MachineOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "machine", "How steadily this machine gives a thread its CPU: the slow spells of a fixed piece of arithmetic "
-                 "timed on every core (what a real-time figure measured meanwhile also measures)");
+      "machine",
+      "How steadily this machine gives a thread its CPU: the slow spells of a fixed piece of arithmetic "
+      "timed on every core (what a real-time figure measured meanwhile also measures)");
   cmd->add_option("--seconds", opts->seconds, "How long to time (default 10)");
   cmd->add_option("--every-ms", opts->every_ms, "One piece every this many milliseconds on each core (default 5)");
   cmd->add_option("--piece-us", opts->piece_us, "The piece's length at full speed in µs (default 50)");
