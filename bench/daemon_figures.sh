@@ -4,7 +4,8 @@
 # loopback, (1) at real-time pace: latency from the last packet of a sweep to its LCM
 # publication (p50, p99), CPU time per second of data, ring drops; (2) as fast as possible:
 # the replay speed as a multiple of real time. Each kind is run TRAJROI_FIGURE_RUNS times (5)
-# and its medians are the figures.
+# and its medians are the figures. Beside each real-time run, `trajroi machine` says how
+# steadily the machine gave a thread its CPU meanwhile (its longest slow spell).
 # Usage: bench/daemon_figures.sh [BUILD_DIR]   (default build/release)
 set -euo pipefail
 export LC_NUMERIC=C  # EPOCHREALTIME and awk agree on the decimal point
