@@ -83,7 +83,14 @@ void time_pieces(Timer& timer, const MachineOptions& o, long steps, double start
     if (t >= end_s) break;
     x = arithmetic(steps, x);
     timer.pieces.push_back({t - start_s, (now_s() - t) * 1e6});
-    long long ns = next.tv_nsec + every_ns;
+    // The next piece one interval on; after a slow spell, one interval from now (catching up
+    // would run pieces back to back, above every other thread).
+    timespec current{};
+    clock_gettime(CLOCK_MONOTONIC, &current);
+    if (next.tv_sec < current.tv_sec || (next.tv_sec == current.tv_sec && next.tv_nsec < current.tv_nsec)) {
+      next = current;
+    }
+    const long long ns = next.tv_nsec + every_ns;
     next.tv_sec += static_cast<time_t>(ns / 1'000'000'000);
     next.tv_nsec = static_cast<long>(ns % 1'000'000'000);
     while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr) == EINTR) {
