@@ -5,11 +5,10 @@
 // and bench/daemon_figures.sh run it beside the daemon to say what the machine did meanwhile.
 #include <pthread.h>
 #include <sched.h>
-#include <time.h>
 
 #include <algorithm>
-#include <cerrno>
-#include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <thread>
@@ -17,6 +16,8 @@
 
 #include "commands.hpp"
 #include "trajroi/eval/steadiness.hpp"
+#include "trajroi/inputs/input_source.hpp"
+#include "trajroi/inputs/pacer.hpp"
 #include "trajroi/roi/cpu.hpp"
 
 namespace trajroi::cli {
@@ -38,21 +39,15 @@ double arithmetic(long steps, double x) noexcept {
   return x;
 }
 
-double now_s() noexcept {
-  timespec t{};
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_nsec) * 1e-9;
-}
-
 // Steps for a piece of about `piece_us` at full speed: the fastest of a few timings.
 long calibrate_steps(double piece_us) {
   constexpr long kProbe = 20'000;
   double fastest_us = 1e30;
   double sink = 1.0;
   for (int i = 0; i < 50; ++i) {
-    const double start = now_s();
+    const std::int64_t start = inputs::monotonic_ns();
     sink = arithmetic(kProbe, sink);
-    fastest_us = std::min(fastest_us, (now_s() - start) * 1e6);
+    fastest_us = std::min(fastest_us, static_cast<double>(inputs::monotonic_ns() - start) * 1e-3);
   }
   if (sink == 0.0) std::puts("");  // keeps the chain
   return std::max(1L, static_cast<long>(static_cast<double>(kProbe) * piece_us / std::max(fastest_us, 1e-3)));
@@ -60,41 +55,34 @@ long calibrate_steps(double piece_us) {
 
 struct Timer {
   std::size_t cpu = 0;
+  bool pinned = false;
   bool fifo = false;
   std::vector<eval::PieceTiming> pieces;
 };
 
-void time_pieces(Timer& timer, const MachineOptions& o, long steps, double start_s) {
+void time_pieces(Timer& timer, const MachineOptions& o, long steps, std::int64_t start_ns) {
   cpu_set_t set;
   CPU_ZERO(&set);
   CPU_SET(timer.cpu, &set);
-  (void)pthread_setaffinity_np(pthread_self(), sizeof set, &set);
+  timer.pinned = pthread_setaffinity_np(pthread_self(), sizeof set, &set) == 0;
   sched_param param{};
   param.sched_priority = o.priority;
   timer.fifo = o.priority > 0 && pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
-  const auto every_ns = static_cast<long long>(o.every_ms * 1e6);
-  timespec next{};
-  clock_gettime(CLOCK_MONOTONIC, &next);
+  const std::int64_t every_ns = std::llround(o.every_ms * 1e6);
+  const std::int64_t end_ns = start_ns + std::llround(o.seconds * 1e9);
+  std::int64_t next_ns = inputs::monotonic_ns();
   double x = 1.0;
-  const double end_s = start_s + o.seconds;
   timer.pieces.reserve(static_cast<std::size_t>(o.seconds * 1e3 / o.every_ms) + 16);
   for (;;) {
-    const double t = now_s();
-    if (t >= end_s) break;
+    const std::int64_t t = inputs::monotonic_ns();
+    if (t >= end_ns) break;
     x = arithmetic(steps, x);
-    timer.pieces.push_back({t - start_s, (now_s() - t) * 1e6});
+    const std::int64_t done = inputs::monotonic_ns();
+    timer.pieces.push_back({static_cast<double>(t - start_ns) * 1e-9, static_cast<double>(done - t) * 1e-3});
     // The next piece one interval on; after a slow spell, one interval from now (catching up
     // would run pieces back to back, above every other thread).
-    timespec current{};
-    clock_gettime(CLOCK_MONOTONIC, &current);
-    if (next.tv_sec < current.tv_sec || (next.tv_sec == current.tv_sec && next.tv_nsec < current.tv_nsec)) {
-      next = current;
-    }
-    const long long ns = next.tv_nsec + every_ns;
-    next.tv_sec += static_cast<time_t>(ns / 1'000'000'000);
-    next.tv_nsec = static_cast<long>(ns % 1'000'000'000);
-    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr) == EINTR) {
-    }
+    next_ns = std::max(next_ns, done) + every_ns;
+    (void)inputs::Pacer::sleep_until(next_ns);
   }
   if (x == 0.0) std::puts("");
 }
@@ -111,14 +99,14 @@ int run_machine(const MachineOptions& o) {
   (void)sched_getaffinity(0, sizeof allowed, &allowed);
   std::vector<Timer> timers;
   for (std::size_t cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
-    if (CPU_ISSET(cpu, &allowed)) timers.push_back({cpu, false, {}});
+    if (CPU_ISSET(cpu, &allowed)) timers.push_back({cpu, false, false, {}});
   }
   const long steps = calibrate_steps(o.piece_us);
-  const double start_s = now_s();
+  const std::int64_t start_ns = inputs::monotonic_ns();
   std::vector<std::thread> threads;
   threads.reserve(timers.size());
   for (Timer& t : timers)
-    threads.emplace_back(time_pieces, std::ref(t), std::cref(o), steps, start_s);
+    threads.emplace_back(time_pieces, std::ref(t), std::cref(o), steps, start_ns);
   for (std::thread& t : threads)
     t.join();
 
@@ -150,9 +138,9 @@ int run_machine(const MachineOptions& o) {
     const eval::Steadiness& s = found[i];
     std::printf(
         "cpu %zu: %zu pieces, full speed %.1f µs, median %.1f µs; %zu slow spells (over 2x full speed), longest "
-        "%.1f ms, worst %.1fx, %.1f ms slow in all\n",
+        "%.1f ms, worst %.1fx, %.1f ms slow in all%s\n",
         timers[i].cpu, s.pieces, s.full_speed_us, s.median_us, s.spells.size(), s.longest_ms(), s.worst_factor(),
-        s.slow_ms());
+        s.slow_ms(), timers[i].pinned ? "" : " (not pinned: it may have moved between cores)");
     int shown = 0;
     for (const eval::SlowSpell& spell : s.spells) {
       if (spell.end_s - spell.start_s < 0.005 || ++shown > 10) continue;
