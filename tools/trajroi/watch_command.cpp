@@ -58,14 +58,18 @@ class TruthScorer {
     const eval::TruthCorridor corridor(run_.trajectory(), centres, circles ? 0.0 : roi.height_m / 2.0,
                                        circles ? 2.0 * roi.radius_m : roi.width_m, !circles);
     eval::place_frame_truth(*frame, run_.truth(), run_.robot_from_lidar(), truth_points_);
+    // A point is known by its time after the sweep's start (the sensor's clock: the same in the
+    // capture and in the daemon, replayed or live), ring and return. Absolute times differ live:
+    // the daemon anchors the sensor's clock to its own receive times, the capture to the
+    // recorded ones.
     std::map<std::tuple<std::int64_t, int, int>, std::size_t> index;
     for (std::size_t i = 0; i < frame->points.size(); ++i) {
       const auto& p = frame->points[i];
-      index[{frame->start_time_ns + p.time_offset_ns, p.ring, static_cast<int>(p.return_type)}] = i;
+      index[{p.time_offset_ns, p.ring, static_cast<int>(p.return_type)}] = i;
     }
     roi::IndexVector kept;
     for (std::size_t k = 0; k < m.x.size(); ++k) {
-      const auto it = index.find({m.sweep_start_ns + m.time_offset_ns[k], m.ring[k], m.return_type[k]});
+      const auto it = index.find({m.time_offset_ns[k], m.ring[k], m.return_type[k]});
       if (it != index.end()) kept.push_back(static_cast<std::uint32_t>(it->second));
     }
     std::sort(kept.begin(), kept.end());
