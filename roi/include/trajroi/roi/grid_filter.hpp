@@ -15,6 +15,14 @@
 #include "trajroi/roi/point.hpp"
 #include "trajroi/roi/shapes.hpp"
 
+// A member the vector scans call into plain x86-64 code: never inlined, and (GCC) never
+// replaced by a clone with its own calling convention (see GridFilter::scalar_block).
+#if defined(__clang__)
+#define TRAJROI_STANDARD_CALL __attribute__((noinline))
+#else
+#define TRAJROI_STANDARD_CALL __attribute__((noipa))
+#endif
+
 namespace trajroi::roi {
 
 enum class SimdPath : unsigned char { kAuto, kAvx512, kAvx2, kSse2, kScalar };
@@ -127,17 +135,30 @@ class GridFilter {
   __attribute__((target("avx512f,popcnt"))) std::size_t scan_avx512(std::span<const PointXYZI> points,
                                                                     Scan& scan) const;
   // For the vector scans. The points first … first + n − 1 one by one, `count` indices
-  // written so far; returns the new count.
-  std::size_t scalar_block(std::span<const PointXYZI> points, std::size_t first, std::size_t n, Scan& scan,
-                           std::size_t count) const;
+  // written so far; returns the new count. Never inlined nor cloned: the scans reach this
+  // plain x86-64 code through a call of the standard ABI, before which the compiler clears
+  // the upper vector state (GCC 12 left it dirty for calls to its own clones, and every SSE
+  // instruction of the callee then paid for a merge with it).
+  TRAJROI_STANDARD_CALL std::size_t scalar_block(std::span<const PointXYZI> points, std::size_t first, std::size_t n,
+                                                 Scan& scan, std::size_t count) const;
   // Bit k set for each lane k of `boundary` whose point first + k is kept, given the lanes'
-  // cell values.
-  [[nodiscard]] unsigned decide_lanes(unsigned boundary, const std::uint32_t* value, std::span<const PointXYZI> points,
-                                      std::size_t first) const;
+  // cell values (kSubIndex false) or the indices of their sub-cells in sub_ (true). Inlined
+  // into each scan, so that it is compiled for the scan's instruction set.
+  template <bool kSubIndex>
+  [[nodiscard]] __attribute__((always_inline)) unsigned decide_lanes(unsigned boundary, const std::uint32_t* value,
+                                                                     std::span<const PointXYZI> points,
+                                                                     std::size_t first) const;
+  // decide_lanes for the AVX2 scan: out of line (inlined, it took ymm registers the scan's
+  // loop needs), compiled for AVX2 (so that no SSE code runs with the vector state dirty).
+  __attribute__((target("avx2"), noinline)) unsigned decide_lanes_avx2(unsigned boundary, const std::uint32_t* value,
+                                                                       std::span<const PointXYZI> points,
+                                                                       std::size_t first) const;
 #endif
 
   // 0/1: is the point (x, y) in a cell with this value kept? Tests candidates for boundary cells.
   [[nodiscard]] std::uint32_t decide(std::uint32_t cell, double x, double y) const noexcept;
+  // The same for the point's sub-cell value in a boundary cell.
+  [[nodiscard]] std::uint32_t decide_sub(std::uint32_t sub, double x, double y) const noexcept;
   // Index into cells_ of the cell holding (x, y); the sentinel when off the grid.
   [[nodiscard]] std::size_t cell_index(float x, float y) const noexcept;
 
