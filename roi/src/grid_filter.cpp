@@ -386,7 +386,7 @@ namespace detail {
 // The scans read the cloud once, front to back, and do little with each cache line: the
 // hardware prefetcher alone leaves them waiting on memory for a cloud larger than the cache
 // (the accumulated 2.88 M-point cloud ran at 1.0–1.4× a memcpy of it on a 2-core Xeon VM;
-// asking for each line 8 KiB ahead brought it to 0.55–0.85×, median of 6 interleaved runs).
+// asking for each line 8 KiB ahead brought it to 0.55–0.85×, six interleaved runs each).
 // Each step of a scan asks for the lines it will read that far ahead, one per line. The
 // address is formed as an integer: it may lie past the cloud (a prefetch never faults).
 inline constexpr std::size_t kPrefetchAhead_bytes = 8192;

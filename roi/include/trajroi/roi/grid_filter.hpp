@@ -183,6 +183,8 @@ class GridFilter {
   std::vector<std::pair<double, double>> roi_centre_;           // build scratch
 };
 
+#undef TRAJROI_STANDARD_CALL
+
 extern template class GridFilter<CircularRoiSet>;
 extern template class GridFilter<RectangularRoiSet>;
 extern template class GridFilter<CorridorRoiSet>;
