@@ -379,7 +379,8 @@ FilterStats GridFilter<RoiSet>::filter(std::span<const Point> points, IndexVecto
 // cell_index(), so every path assigns every point the same cell. A block in which a point is
 // non-finite or outside the z limits is handed to the scalar code point by point (which
 // counts the rejections); points in boundary cells are decided by decide() one by one — in
-// the SSE2 scan for the whole block, in the AVX2 and AVX-512 scans for those lanes only. All
+// the SSE2 scan for the whole block, in the AVX2 scan for those lanes only — and in the
+// AVX-512 scan by decide_sub(), their sub-cells located for all those lanes at once. All
 // return the index of the first point they did not process.
 #if defined(__x86_64__) || defined(__i386__)
 namespace detail {
@@ -389,12 +390,20 @@ namespace detail {
 // asking for each line 8 KiB ahead brought it to 0.55–0.85×, six interleaved runs each).
 // Each step of a scan asks for the lines it will read that far ahead, one per line. The
 // address is formed as an integer: it may lie past the cloud (a prefetch never faults).
+// Only a cloud too large for the caches is streamed so: the daemon scans each packet's few
+// hundred points just after placing them (in L1), where prefetches that far ahead would fetch
+// lines past the batch. A smaller cloud asks for the lines it is reading (no branch in the
+// loop, no line fetched for nothing).
 inline constexpr std::size_t kPrefetchAhead_bytes = 8192;
 inline constexpr std::size_t kCacheLine_bytes = 64;
+inline constexpr std::size_t kStreamFrom_bytes = std::size_t{1} << 20;
+[[nodiscard]] inline std::size_t prefetch_distance(std::span<const PointXYZI> points) noexcept {
+  return points.size_bytes() >= kStreamFrom_bytes ? kPrefetchAhead_bytes : 0;
+}
 template <std::size_t kBytes>
-__attribute__((always_inline)) inline void prefetch_ahead(const float* step) {
+__attribute__((always_inline)) inline void prefetch_ahead(const float* step, std::size_t distance) {
   static_assert(kBytes % kCacheLine_bytes == 0);
-  const auto at = reinterpret_cast<std::uintptr_t>(step) + kPrefetchAhead_bytes;
+  const auto at = reinterpret_cast<std::uintptr_t>(step) + distance;
   for (std::size_t line = 0; line < kBytes; line += kCacheLine_bytes)
     _mm_prefetch(reinterpret_cast<const char*>(at + line), _MM_HINT_T0);
 }
@@ -422,9 +431,10 @@ std::size_t GridFilter<RoiSet>::scan_sse2(std::span<const PointXYZI> points, Sca
   std::uint32_t* const out = scan.out;
   std::size_t count = scan.count;
   alignas(16) std::int32_t cell_of[4];
+  const std::size_t ahead = detail::prefetch_distance(points);
   std::size_t i = 0;
   for (; i + 4 <= points.size(); i += 4) {
-    detail::prefetch_ahead<4 * sizeof(PointXYZI)>(base + 4 * i);
+    detail::prefetch_ahead<4 * sizeof(PointXYZI)>(base + 4 * i, ahead);
     __m128 px = _mm_loadu_ps(base + 4 * i);
     __m128 py = _mm_loadu_ps(base + 4 * i + 4);
     __m128 pz = _mm_loadu_ps(base + 4 * i + 8);
@@ -663,9 +673,10 @@ __attribute__((target("avx2,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx2
   // values of the same half one step earlier. All reused cells start as the sentinel.
   detail::Avx2Reuse first_half{grid.sentinel, _mm256_setzero_si256()};
   detail::Avx2Reuse second_half = first_half;
+  const std::size_t ahead = detail::prefetch_distance(points);
   std::size_t i = 0;
   for (; i + 16 <= points.size(); i += 16) {
-    detail::prefetch_ahead<16 * sizeof(PointXYZI)>(base + 4 * i);
+    detail::prefetch_ahead<16 * sizeof(PointXYZI)>(base + 4 * i, ahead);
     const detail::Avx2Block a = detail::avx2_block(base + 4 * i, grid);
     const detail::Avx2Block b = detail::avx2_block(base + 4 * (i + 8), grid);
     finish(i, a, first_half);
@@ -815,9 +826,10 @@ __attribute__((target("avx512f,popcnt"))) std::size_t GridFilter<RoiSet>::scan_a
     count += static_cast<std::size_t>(__builtin_popcount(keep));
   };
   // Two blocks per step: both are located before either is looked up.
+  const std::size_t ahead = detail::prefetch_distance(points);
   std::size_t i = 0;
   for (; i + 32 <= points.size(); i += 32) {
-    detail::prefetch_ahead<32 * sizeof(PointXYZI)>(base + 4 * i);
+    detail::prefetch_ahead<32 * sizeof(PointXYZI)>(base + 4 * i, ahead);
     const detail::Avx512Block a = detail::avx512_block(base + 4 * i, grid);
     const detail::Avx512Block b = detail::avx512_block(base + 4 * (i + 16), grid);
     finish(i, a);

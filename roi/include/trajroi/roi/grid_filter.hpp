@@ -148,8 +148,9 @@ class GridFilter {
   [[nodiscard]] __attribute__((always_inline)) unsigned decide_lanes(unsigned boundary, const std::uint32_t* value,
                                                                      std::span<const PointXYZI> points,
                                                                      std::size_t first) const;
-  // decide_lanes for the AVX2 scan: out of line (inlined, it took ymm registers the scan's
-  // loop needs), compiled for AVX2 (so that no SSE code runs with the vector state dirty).
+  // decide_lanes for the AVX2 scan: out of line (inlined, the scan's loop reloaded its
+  // constants from the stack: 16 ymm registers are few), compiled for AVX2 (so that no SSE
+  // code runs with the upper vector state dirty).
   __attribute__((target("avx2"), noinline)) unsigned decide_lanes_avx2(unsigned boundary, const std::uint32_t* value,
                                                                        std::span<const PointXYZI> points,
                                                                        std::size_t first) const;
