@@ -378,10 +378,10 @@ FilterStats GridFilter<RoiSet>::filter(std::span<const Point> points, IndexVecto
 // intensity); the scans compute the cell of each point with the same float operations as
 // cell_index(), so every path assigns every point the same cell. A block in which a point is
 // non-finite or outside the z limits is handed to the scalar code point by point (which
-// counts the rejections); points in boundary cells are decided by decide() one by one — in
-// the SSE2 scan for the whole block, in the AVX2 scan for those lanes only — and in the
-// AVX-512 scan by decide_sub(), their sub-cells located for all those lanes at once. All
-// return the index of the first point they did not process.
+// counts the rejections); points in boundary cells are decided by decide() one by one in
+// the SSE2 scan (the whole block), and in the AVX2 and AVX-512 scans by decide_sub(), their
+// sub-cells located for all those lanes at once. All return the index of the first point
+// they did not process.
 #if defined(__x86_64__) || defined(__i386__)
 namespace detail {
 // The scans read the cloud once, front to back, and do little with each cache line: the
@@ -495,23 +495,22 @@ std::size_t GridFilter<RoiSet>::scalar_block(std::span<const PointXYZI> points, 
 }
 
 template <typename RoiSet>
-template <bool kSubIndex>
-inline unsigned GridFilter<RoiSet>::decide_lanes(unsigned boundary, const std::uint32_t* value,
+inline unsigned GridFilter<RoiSet>::decide_lanes(unsigned boundary, const std::uint32_t* sub_index,
                                                  std::span<const PointXYZI> points, std::size_t first) const {
   unsigned keep = 0;
   for (; boundary != 0; boundary &= boundary - 1) {
     const auto k = static_cast<unsigned>(__builtin_ctz(boundary));
-    const auto x = static_cast<double>(points[first + k].x);
-    const auto y = static_cast<double>(points[first + k].y);
-    keep |= (kSubIndex ? decide_sub(sub_[value[k]], x, y) : decide(value[k], x, y)) << k;
+    keep |= decide_sub(sub_[sub_index[k]], static_cast<double>(points[first + k].x),
+                       static_cast<double>(points[first + k].y))
+            << k;
   }
   return keep;
 }
 
 template <typename RoiSet>
-unsigned GridFilter<RoiSet>::decide_lanes_avx2(unsigned boundary, const std::uint32_t* value,
+unsigned GridFilter<RoiSet>::decide_lanes_avx2(unsigned boundary, const std::uint32_t* sub_index,
                                                std::span<const PointXYZI> points, std::size_t first) const {
-  return decide_lanes<false>(boundary, value, points, first);
+  return decide_lanes(boundary, sub_index, points, first);
 }
 
 namespace detail {
@@ -560,21 +559,21 @@ __attribute__((target("avx2"), always_inline)) inline Avx2Block avx2_block(const
   const __m256 px = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));  // x 0 2 4 6 | 1 3 5 7
   const __m256 py = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
   const __m256 pz = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
-  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-  const __m256 max_finite = _mm256_set1_ps(std::numeric_limits<float>::max());
-  __m256 pass = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(_mm256_and_ps(px, abs_mask), max_finite, _CMP_LE_OQ),
-                                            _mm256_cmp_ps(_mm256_and_ps(py, abs_mask), max_finite, _CMP_LE_OQ)),
-                              _mm256_cmp_ps(_mm256_and_ps(pz, abs_mask), max_finite, _CMP_LE_OQ));
+  // v − v is 0 for every finite v and NaN for ±∞ and NaN: the sum is 0 when all three are finite.
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 finite_sum =
+      _mm256_add_ps(_mm256_add_ps(_mm256_sub_ps(px, px), _mm256_sub_ps(py, py)), _mm256_sub_ps(pz, pz));
+  __m256 pass = _mm256_cmp_ps(finite_sum, zero, _CMP_EQ_OQ);
   if (g.z_limited) {
     pass = _mm256_and_ps(pass,
                          _mm256_and_ps(_mm256_cmp_ps(pz, g.z_lo, _CMP_GE_OQ), _mm256_cmp_ps(pz, g.z_hi, _CMP_LE_OQ)));
   }
-  const __m256 zero = _mm256_setzero_ps();
   const __m256 fx = _mm256_mul_ps(_mm256_sub_ps(px, g.x0), g.inv);
   const __m256 fy = _mm256_mul_ps(_mm256_sub_ps(py, g.y0), g.inv);
+  // fx ≥ 0 and fy ≥ 0 as min(fx, fy) ≥ 0 (a NaN, from a non-finite point, makes the block unclean).
   const __m256 on_grid =
-      _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(fx, zero, _CMP_GE_OQ), _mm256_cmp_ps(fx, g.nx_f, _CMP_LT_OQ)),
-                    _mm256_and_ps(_mm256_cmp_ps(fy, zero, _CMP_GE_OQ), _mm256_cmp_ps(fy, g.ny_f, _CMP_LT_OQ)));
+      _mm256_and_ps(_mm256_cmp_ps(_mm256_min_ps(fx, fy), zero, _CMP_GE_OQ),
+                    _mm256_and_ps(_mm256_cmp_ps(fx, g.nx_f, _CMP_LT_OQ), _mm256_cmp_ps(fy, g.ny_f, _CMP_LT_OQ)));
   // Off-grid lanes are zeroed before converting; on-grid values are ≥ 0 (truncation floors).
   const __m256i ix = _mm256_cvttps_epi32(_mm256_and_ps(fx, on_grid));
   const __m256i iy = _mm256_cvttps_epi32(_mm256_and_ps(fy, on_grid));
@@ -630,6 +629,37 @@ __attribute__((target("avx2"), always_inline)) inline unsigned avx2_boundary(__m
 __attribute__((target("avx2"), always_inline)) inline void avx2_store(__m256i value, std::uint32_t* out) {
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), value);
 }
+
+// As avx512_sub_index, for the eight points at `p` with cell values `cell_value` (in point
+// order): the indices into GridFilter::sub_ of their sub-cells, meaningful in the boundary
+// lanes only. Their grid coordinates are computed again (the same float operations as
+// avx2_block): this runs for one block in seven or so, and keeping them from avx2_block
+// would cost the main loop registers it does not have.
+template <std::uint32_t kSub, std::uint32_t kFirstBoundary>
+__attribute__((target("avx2"), always_inline)) inline __m256i avx2_sub_index(const float* p, const Avx2Grid& g,
+                                                                             __m256i cell_value) {
+  const __m256 a = _mm256_loadu_ps(p);
+  const __m256 b = _mm256_loadu_ps(p + 8);
+  const __m256 c = _mm256_loadu_ps(p + 16);
+  const __m256 d = _mm256_loadu_ps(p + 24);
+  const __m256 t0 = _mm256_unpacklo_ps(a, b);  // x0 x2 y0 y2 | x1 x3 y1 y3
+  const __m256 t2 = _mm256_unpacklo_ps(c, d);
+  const __m256i natural = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
+  const __m256 px = _mm256_permutevar8x32_ps(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)), natural);
+  const __m256 py = _mm256_permutevar8x32_ps(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)), natural);
+  const __m256 fx = _mm256_mul_ps(_mm256_sub_ps(px, g.x0), g.inv);
+  const __m256 fy = _mm256_mul_ps(_mm256_sub_ps(py, g.y0), g.inv);
+  const __m256 per_side = _mm256_set1_ps(static_cast<float>(kSub));
+  const __m256i last = _mm256_set1_epi32(static_cast<std::int32_t>(kSub - 1));
+  const __m256 frac_x = _mm256_sub_ps(fx, _mm256_cvtepi32_ps(_mm256_cvttps_epi32(fx)));
+  const __m256 frac_y = _mm256_sub_ps(fy, _mm256_cvtepi32_ps(_mm256_cvttps_epi32(fy)));
+  const __m256i sx = _mm256_min_epu32(_mm256_cvttps_epi32(_mm256_mul_ps(frac_x, per_side)), last);
+  const __m256i sy = _mm256_min_epu32(_mm256_cvttps_epi32(_mm256_mul_ps(frac_y, per_side)), last);
+  // ((cell value − first boundary value) · kSub + sy) · kSub + sx
+  const __m256i side = _mm256_set1_epi32(static_cast<std::int32_t>(kSub));
+  const __m256i id = _mm256_sub_epi32(cell_value, _mm256_set1_epi32(kFirstBoundary));
+  return _mm256_add_epi32(_mm256_mullo_epi32(_mm256_add_epi32(_mm256_mullo_epi32(id, side), sy), side), sx);
+}
 }  // namespace detail
 
 template <typename RoiSet>
@@ -663,9 +693,10 @@ __attribute__((target("avx2,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx2
     const __m256i value = detail::avx2_values(block.cell, reuse, grid.cells);
     unsigned keep = detail::avx2_inside(value);
     if (const unsigned boundary = detail::avx2_boundary(value); boundary != 0) [[unlikely]] {
-      std::uint32_t cell_value[8];
-      detail::avx2_store(value, cell_value);
-      keep |= decide_lanes_avx2(boundary, cell_value, points, first);
+      // Their sub-cells, located all at once; only points in boundary sub-cells test candidates.
+      alignas(32) std::uint32_t sub_index[8];
+      detail::avx2_store(detail::avx2_sub_index<kSub, kFirstBoundary>(base + 4 * first, grid, value), sub_index);
+      keep |= decide_lanes_avx2(boundary, sub_index, points, first);
     }
     count += detail::avx2_emit(keep, first, out + count);
   };
@@ -819,7 +850,7 @@ __attribute__((target("avx512f,popcnt"))) std::size_t GridFilter<RoiSet>::scan_a
       // Their sub-cells, located all at once; only points in boundary sub-cells test candidates.
       alignas(64) std::uint32_t sub_index[16];
       _mm512_store_si512(sub_index, detail::avx512_sub_index<kSub, kFirstBoundary>(boundary, block, cell_value));
-      keep |= decide_lanes<true>(boundary, sub_index, points, first);
+      keep |= decide_lanes(boundary, sub_index, points, first);
     }
     const __m512i indices = _mm512_add_epi32(_mm512_set1_epi32(static_cast<std::int32_t>(first)), lane);
     _mm512_storeu_si512(out + count, _mm512_maskz_compress_epi32(static_cast<__mmask16>(keep), indices));

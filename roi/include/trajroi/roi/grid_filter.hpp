@@ -141,17 +141,17 @@ class GridFilter {
   // instruction of the callee then paid for a merge with it).
   TRAJROI_STANDARD_CALL std::size_t scalar_block(std::span<const PointXYZI> points, std::size_t first, std::size_t n,
                                                  Scan& scan, std::size_t count) const;
-  // Bit k set for each lane k of `boundary` whose point first + k is kept, given the lanes'
-  // cell values (kSubIndex false) or the indices of their sub-cells in sub_ (true). Inlined
-  // into each scan, so that it is compiled for the scan's instruction set.
-  template <bool kSubIndex>
-  [[nodiscard]] __attribute__((always_inline)) unsigned decide_lanes(unsigned boundary, const std::uint32_t* value,
+  // Bit k set for each lane k of `boundary` whose point first + k is kept, given the indices
+  // of the lanes' sub-cells in sub_. Inlined into each scan, so that it is compiled for the
+  // scan's instruction set.
+  [[nodiscard]] __attribute__((always_inline)) unsigned decide_lanes(unsigned boundary, const std::uint32_t* sub_index,
                                                                      std::span<const PointXYZI> points,
                                                                      std::size_t first) const;
   // decide_lanes for the AVX2 scan: out of line (inlined, the scan's loop reloaded its
   // constants from the stack: 16 ymm registers are few), compiled for AVX2 (so that no SSE
   // code runs with the upper vector state dirty).
-  __attribute__((target("avx2"), noinline)) unsigned decide_lanes_avx2(unsigned boundary, const std::uint32_t* value,
+  __attribute__((target("avx2"), noinline)) unsigned decide_lanes_avx2(unsigned boundary,
+                                                                       const std::uint32_t* sub_index,
                                                                        std::span<const PointXYZI> points,
                                                                        std::size_t first) const;
 #endif
