@@ -220,6 +220,8 @@ class SweepProcessor {
   void start_sweep(const vlp16::Frame& frame);
   void add_points(const vlp16::Frame& frame, std::size_t first, SweepSink& sink);
   void end_sweep(const vlp16::Frame& frame, SweepSink& sink);
+  // Filters the frame's points not filtered yet, in batches, while at least `at_least` wait.
+  void filter_points(const vlp16::Frame& frame, std::size_t at_least, SweepSink& sink);
   // Places points [first, end) of the frame in the global frame (one pose per firing, or the
   // sweep's), filters them in one scan and appends the kept ones. Answers kValid, or the
   // status of a firing whose pose was not valid (the sweep is then withheld).
@@ -247,8 +249,9 @@ class SweepProcessor {
 
   Sweep sweep_;
   bool in_sweep_ = false;
+  std::size_t unfiltered_from_ = 0;  // the frame's points before this one are filtered
   Eigen::Isometry3d sweep_sensor_pose_ = Eigen::Isometry3d::Identity();
-  std::vector<roi::PointXYZI> scratch_;  // one packet's points in the global frame
+  std::vector<roi::PointXYZI> scratch_;  // one batch's points in the global frame
   roi::IndexVector kept_;
   std::int64_t arrival_ns_ = 0;
   bool keep_indices_ = false;
