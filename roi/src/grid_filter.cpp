@@ -547,7 +547,14 @@ struct Avx2Block {
   bool clean;
 };
 
-__attribute__((target("avx2"), always_inline)) inline Avx2Block avx2_block(const float* p, const Avx2Grid& g) {
+// The x, y and z of the eight points at `p`, in lane order 0 2 4 6 1 3 5 7 (what the
+// transposition gives), and their grid coordinates in cells.
+struct Avx2Points {
+  __m256 x, y, z;
+  __m256 fx, fy;
+};
+
+__attribute__((target("avx2"), always_inline)) inline Avx2Points avx2_points(const float* p, const Avx2Grid& g) {
   const __m256 a = _mm256_loadu_ps(p);         // points 0, 1
   const __m256 b = _mm256_loadu_ps(p + 8);     // points 2, 3
   const __m256 c = _mm256_loadu_ps(p + 16);    // points 4, 5
@@ -559,6 +566,16 @@ __attribute__((target("avx2"), always_inline)) inline Avx2Block avx2_block(const
   const __m256 px = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));  // x 0 2 4 6 | 1 3 5 7
   const __m256 py = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
   const __m256 pz = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
+  return {px, py, pz, _mm256_mul_ps(_mm256_sub_ps(px, g.x0), g.inv), _mm256_mul_ps(_mm256_sub_ps(py, g.y0), g.inv)};
+}
+
+// The transposition's lane order put back to point order.
+__attribute__((target("avx2"), always_inline)) inline __m256i avx2_natural(__m256i v) {
+  return _mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7));
+}
+
+__attribute__((target("avx2"), always_inline)) inline Avx2Block avx2_block(const float* p, const Avx2Grid& g) {
+  const auto [px, py, pz, fx, fy] = avx2_points(p, g);
   // v − v is 0 for every finite v and NaN for ±∞ and NaN: the sum is 0 when all three are finite.
   const __m256 zero = _mm256_setzero_ps();
   const __m256 finite_sum =
@@ -568,8 +585,6 @@ __attribute__((target("avx2"), always_inline)) inline Avx2Block avx2_block(const
     pass = _mm256_and_ps(pass,
                          _mm256_and_ps(_mm256_cmp_ps(pz, g.z_lo, _CMP_GE_OQ), _mm256_cmp_ps(pz, g.z_hi, _CMP_LE_OQ)));
   }
-  const __m256 fx = _mm256_mul_ps(_mm256_sub_ps(px, g.x0), g.inv);
-  const __m256 fy = _mm256_mul_ps(_mm256_sub_ps(py, g.y0), g.inv);
   // fx ≥ 0 and fy ≥ 0 as min(fx, fy) ≥ 0 (a NaN, from a non-finite point, makes the block unclean).
   const __m256 on_grid =
       _mm256_and_ps(_mm256_cmp_ps(_mm256_min_ps(fx, fy), zero, _CMP_GE_OQ),
@@ -579,9 +594,7 @@ __attribute__((target("avx2"), always_inline)) inline Avx2Block avx2_block(const
   const __m256i iy = _mm256_cvttps_epi32(_mm256_and_ps(fy, on_grid));
   const __m256i cell = _mm256_blendv_epi8(g.sentinel, _mm256_add_epi32(_mm256_mullo_epi32(iy, g.nx_i), ix),
                                           _mm256_castps_si256(on_grid));
-  // The transposition left the points in lane order 0 2 4 6 1 3 5 7; put them back.
-  const __m256i natural = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
-  return {_mm256_permutevar8x32_epi32(cell, natural), _mm256_movemask_ps(pass) == 0xff};
+  return {avx2_natural(cell), _mm256_movemask_ps(pass) == 0xff};
 }
 
 // A LiDAR cloud in firing order brings the same laser back every block or two, and its
@@ -632,29 +645,19 @@ __attribute__((target("avx2"), always_inline)) inline void avx2_store(__m256i va
 
 // As avx512_sub_index, for the eight points at `p` with cell values `cell_value` (in point
 // order): the indices into GridFilter::sub_ of their sub-cells, meaningful in the boundary
-// lanes only. Their grid coordinates are computed again (the same float operations as
-// avx2_block): this runs for one block in seven or so, and keeping them from avx2_block
-// would cost the main loop registers it does not have.
+// lanes only. Their grid coordinates are located again (avx2_points, as in avx2_block): this
+// runs for one block in seven or so, and keeping them from avx2_block would cost the main
+// loop registers it does not have.
 template <std::uint32_t kSub, std::uint32_t kFirstBoundary>
 __attribute__((target("avx2"), always_inline)) inline __m256i avx2_sub_index(const float* p, const Avx2Grid& g,
                                                                              __m256i cell_value) {
-  const __m256 a = _mm256_loadu_ps(p);
-  const __m256 b = _mm256_loadu_ps(p + 8);
-  const __m256 c = _mm256_loadu_ps(p + 16);
-  const __m256 d = _mm256_loadu_ps(p + 24);
-  const __m256 t0 = _mm256_unpacklo_ps(a, b);  // x0 x2 y0 y2 | x1 x3 y1 y3
-  const __m256 t2 = _mm256_unpacklo_ps(c, d);
-  const __m256i natural = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
-  const __m256 px = _mm256_permutevar8x32_ps(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)), natural);
-  const __m256 py = _mm256_permutevar8x32_ps(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)), natural);
-  const __m256 fx = _mm256_mul_ps(_mm256_sub_ps(px, g.x0), g.inv);
-  const __m256 fy = _mm256_mul_ps(_mm256_sub_ps(py, g.y0), g.inv);
+  const Avx2Points at = avx2_points(p, g);
   const __m256 per_side = _mm256_set1_ps(static_cast<float>(kSub));
   const __m256i last = _mm256_set1_epi32(static_cast<std::int32_t>(kSub - 1));
-  const __m256 frac_x = _mm256_sub_ps(fx, _mm256_cvtepi32_ps(_mm256_cvttps_epi32(fx)));
-  const __m256 frac_y = _mm256_sub_ps(fy, _mm256_cvtepi32_ps(_mm256_cvttps_epi32(fy)));
-  const __m256i sx = _mm256_min_epu32(_mm256_cvttps_epi32(_mm256_mul_ps(frac_x, per_side)), last);
-  const __m256i sy = _mm256_min_epu32(_mm256_cvttps_epi32(_mm256_mul_ps(frac_y, per_side)), last);
+  const __m256 frac_x = _mm256_sub_ps(at.fx, _mm256_cvtepi32_ps(_mm256_cvttps_epi32(at.fx)));
+  const __m256 frac_y = _mm256_sub_ps(at.fy, _mm256_cvtepi32_ps(_mm256_cvttps_epi32(at.fy)));
+  const __m256i sx = avx2_natural(_mm256_min_epu32(_mm256_cvttps_epi32(_mm256_mul_ps(frac_x, per_side)), last));
+  const __m256i sy = avx2_natural(_mm256_min_epu32(_mm256_cvttps_epi32(_mm256_mul_ps(frac_y, per_side)), last));
   // ((cell value − first boundary value) · kSub + sy) · kSub + sx
   const __m256i side = _mm256_set1_epi32(static_cast<std::int32_t>(kSub));
   const __m256i id = _mm256_sub_epi32(cell_value, _mm256_set1_epi32(kFirstBoundary));
