@@ -59,7 +59,8 @@ StreamDecoder::StreamDecoder(const Calibration& calibration, StreamOptions optio
 void StreamDecoder::on_data_packet(std::span<const std::uint8_t> payload, std::int64_t receive_time_ns, FrameSink& sink,
                                    const DecodedPacket* decoded) {
   ++counters_.data_packets;
-  const PacketError error = validate_data_packet(payload);
+  // A packet decoded ahead was valid there (its bytes are the same).
+  const PacketError error = decoded != nullptr ? PacketError::kNone : validate_data_packet(payload);
   if (error != PacketError::kNone) {
     ++counters_.rejected[static_cast<std::size_t>(error)];
     if (error == PacketError::kUnsupportedProduct) (void)model_.check(payload);  // records the reason

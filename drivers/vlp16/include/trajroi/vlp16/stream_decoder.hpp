@@ -131,8 +131,9 @@ class StreamDecoder {
  public:
   StreamDecoder(const Calibration& calibration, StreamOptions options);
 
-  // One port-2368 payload. May complete a frame (rarely two) into `sink`. `decoded`: its
-  // points already decoded by decoder().decode() (the same points as decoding it here), or
+  // One port-2368 payload. May complete a frame (rarely two) into `sink`. `decoded`: the
+  // points of a payload that passed validate_data_packet(), already decoded by
+  // decoder().decode() (the same points as decoding it here; it is not validated again), or
   // null.
   void on_data_packet(std::span<const std::uint8_t> payload, std::int64_t receive_time_ns, FrameSink& sink,
                       const DecodedPacket* decoded = nullptr);
