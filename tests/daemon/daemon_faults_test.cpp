@@ -1,7 +1,8 @@
 // trajroid live under faults: real processes, pseudo-terminals and loopback sockets, no mocks.
 // `trajroi feed` plays a simulated run into the daemon as its sensors would (UDP datagrams
 // to 127.0.0.1, GNSS and IMU through pseudo-terminals) and injects the fault; the test
-// listens over LCM and reads the daemon's counters.
+// listens over LCM and reads the daemon's counters. Without a fault, `trajroi watch` scores
+// the live daemon's sweeps against the run's truth (TrajroidLive).
 #include <algorithm>
 #include <cstdlib>
 
@@ -322,6 +323,53 @@ TEST(TrajroidFaults, UdpFloodWithMalformedPacketsIsCountedBoundedAndRecoveredFro
     EXPECT_GT(published_during, during / 2);
   }
   EXPECT_GT(checked_after, 100U);
+}
+
+// The corridor fed live as its sensors would (UDP datagrams to 127.0.0.1, GNSS and IMU bytes
+// through pseudo-terminals, at the recorded pace), heard over LCM by `trajroi watch --run` as
+// any client hears it, and scored there against the scenario's truth (each sweep decoded again
+// from the capture, its points placed with the true pose, the truth the corridor along the
+// sweep's published ROI chain): every sweep published is heard, and the daemon keeps the
+// corridor's points and little else. A manual run of the same (2026-12-01) scored recall
+// 0.9989 and precision 0.99998 over 265 sweeps.
+TEST(TrajroidLive, CorridorFedLiveIsScoredByTrajroiWatchAgainstTheTruth) {
+  const fs::path& run = corridor_run();
+  LiveRig rig(run, "WATCH", 3);
+  const fs::path watch_log = rig.dir / "watch.log";
+  Child watch(
+      TRAJROI_CLI,
+      {"watch", "--run", run.string(), "--lcm-url", kTestLcmUrl, "--channel-prefix", rig.prefix, "--seconds", "120"},
+      watch_log);
+  Child daemon({"--config", rig.config.string(), "--lcm-url", kTestLcmUrl}, rig.daemon_log);
+  // The feed starts once the watch hears the daemon's status (each second from its start): the
+  // corridor's second sweep is published 0.2 s into the data, before the watch has read the
+  // run's truth (0.3 s), and a client that is not listening yet does not get it.
+  const auto until = std::chrono::steady_clock::now() + seconds(20);
+  while (std::chrono::steady_clock::now() < until && slurp(watch_log).find("status ") == std::string::npos)
+    std::this_thread::sleep_for(milliseconds(50));
+  ASSERT_NE(slurp(watch_log).find("status "), std::string::npos) << "the watch never heard the daemon\n" << rig.logs();
+  Child feed(TRAJROI_CLI, rig.feed_args(run, {}), rig.feed_log);
+  ASSERT_TRUE(stop_after_feed(rig, daemon, seconds(60)));
+  // It ends at the daemon's final status.
+  ASSERT_EQ(watch.wait(seconds(15)), 0) << slurp(watch_log) << rig.logs();
+
+  // "trajroi watch: H sweeps heard of P published (W withheld …)" and "… over S sweeps:
+  // precision p, recall r, accuracy a (TP …, FP …, FN …, TN …)"
+  const std::string log = slurp(watch_log);
+  const std::int64_t heard = count_after(log, "trajroi watch: ");
+  const std::int64_t published = count_after(log, "sweeps heard of ");
+  const std::int64_t scored = count_after(log, "truth over ");
+  const double precision = number_after(log, "precision ");
+  const double recall = number_after(log, "recall ");
+  std::printf("live corridor: %lld sweeps published, %lld heard, %lld scored: precision %.5f, recall %.5f\n",
+              static_cast<long long>(published), static_cast<long long>(heard), static_cast<long long>(scored),
+              precision, recall);
+  // 266 in an as-fast replay; live, the pose becomes valid a sweep or two later or earlier.
+  EXPECT_GE(published, 255) << log << rig.logs();
+  EXPECT_EQ(heard, published) << log;
+  EXPECT_EQ(scored, heard) << "every sweep heard has its capture frame and ROI chain\n" << log;
+  EXPECT_GE(recall, 0.995) << log;
+  EXPECT_GE(precision, 0.999) << log;
 }
 
 }  // namespace
