@@ -27,6 +27,25 @@ void put_f32(Bytes& out, float v) {
   framing::put_le_u32(out, std::bit_cast<std::uint32_t>(v));
 }
 
+// The little-endian readers every framer uses, at every offset (unaligned included), against
+// values written out byte by byte here.
+TEST(LittleEndian, ReadsFieldsAtAnyOffset) {
+  const Bytes bytes{0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07, 0x08, 0x09, 0xFE, 0xFF, 0x00, 0x00, 0x80, 0x3F};
+  for (std::size_t at = 0; at + 2 <= bytes.size(); ++at) {
+    EXPECT_EQ(framing::le_u16(bytes, at), bytes[at] + 256U * bytes[at + 1]) << at;
+  }
+  for (std::size_t at = 0; at + 4 <= bytes.size(); ++at) {
+    std::uint32_t expected = 0;
+    for (std::size_t k = 4; k-- > 0;)
+      expected = expected * 256U + bytes[at + k];
+    EXPECT_EQ(framing::le_u32(bytes, at), expected) << at;
+  }
+  EXPECT_EQ(framing::le_u64(bytes, 1), 0x0908070605040302ULL);
+  EXPECT_EQ(framing::le_i16(bytes, 9), -2);       // FE FF
+  EXPECT_EQ(framing::le_f32(bytes, 11), 1.0F);    // 00 00 80 3F
+  EXPECT_EQ(framing::le_i32(bytes, 7), -128760);  // 08 09 FE FF
+}
+
 // Common group: TimeStartup, TimeGps, YawPitchRoll, Quaternion, AngularRate, Accel, MagPres.
 Bytes common_frame(std::uint64_t startup_ns, float yaw_deg) {
   Bytes payload;

@@ -5,15 +5,28 @@
 #include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <span>
 #include <vector>
 
 namespace trajroi::framing {
 
+// On a little-endian host one unaligned load (GCC 12 leaves the bytes' shifts and ors as they
+// are: four instructions for a u16 in the VLP-16 decoder's inner loop).
 [[nodiscard]] inline std::uint16_t le_u16(std::span<const std::uint8_t> b, std::size_t at) noexcept {
+  if constexpr (std::endian::native == std::endian::little) {
+    std::uint16_t v;
+    std::memcpy(&v, b.subspan(at, sizeof v).data(), sizeof v);
+    return v;
+  }
   return static_cast<std::uint16_t>(b[at] | (b[at + 1] << 8));
 }
 [[nodiscard]] inline std::uint32_t le_u32(std::span<const std::uint8_t> b, std::size_t at) noexcept {
+  if constexpr (std::endian::native == std::endian::little) {
+    std::uint32_t v;
+    std::memcpy(&v, b.subspan(at, sizeof v).data(), sizeof v);
+    return v;
+  }
   return static_cast<std::uint32_t>(b[at]) | (static_cast<std::uint32_t>(b[at + 1]) << 8) |
          (static_cast<std::uint32_t>(b[at + 2]) << 16) | (static_cast<std::uint32_t>(b[at + 3]) << 24);
 }
