@@ -131,7 +131,7 @@ void log_summary(const Pipeline& pipeline, const Publisher& publisher, std::int6
   const double wall_s = static_cast<double>(steady_ns() - start_ns) * 1e-9;
   const auto& p = s.processor;
   log::info(
-      "summary: {:.2f} s | sweeps {} published {} withheld (no pose) {} | points in {} kept {} ({:.1f} %) | "
+      "summary: {:.3f} s | sweeps {} published {} withheld (no pose) {} | points in {} kept {} ({:.1f} %) | "
       "latency p50 {:.3f} ms p99 {:.3f} ms over {} sweeps | ring drops {} | lost packets {} | decode errors {}",
       wall_s, p.sweeps, p.sweeps_filtered, p.sweeps_without_pose, p.points_in, p.points_kept,
       p.points_in > 0 ? 100.0 * static_cast<double>(p.points_kept) / static_cast<double>(p.points_in) : 0.0,
