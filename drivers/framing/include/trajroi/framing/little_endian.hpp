@@ -11,22 +11,24 @@
 
 namespace trajroi::framing {
 
+namespace detail {
+// The bytes at `at` as the host stores a T: one unaligned load.
+template <typename T>
+[[nodiscard]] inline T host_load(std::span<const std::uint8_t> b, std::size_t at) noexcept {
+  T v;
+  std::memcpy(&v, b.subspan(at, sizeof v).data(), sizeof v);
+  return v;
+}
+}  // namespace detail
+
 // On a little-endian host one unaligned load (GCC 12 leaves the bytes' shifts and ors as they
 // are: four instructions for a u16 in the VLP-16 decoder's inner loop).
 [[nodiscard]] inline std::uint16_t le_u16(std::span<const std::uint8_t> b, std::size_t at) noexcept {
-  if constexpr (std::endian::native == std::endian::little) {
-    std::uint16_t v;
-    std::memcpy(&v, b.subspan(at, sizeof v).data(), sizeof v);
-    return v;
-  }
+  if constexpr (std::endian::native == std::endian::little) return detail::host_load<std::uint16_t>(b, at);
   return static_cast<std::uint16_t>(b[at] | (b[at + 1] << 8));
 }
 [[nodiscard]] inline std::uint32_t le_u32(std::span<const std::uint8_t> b, std::size_t at) noexcept {
-  if constexpr (std::endian::native == std::endian::little) {
-    std::uint32_t v;
-    std::memcpy(&v, b.subspan(at, sizeof v).data(), sizeof v);
-    return v;
-  }
+  if constexpr (std::endian::native == std::endian::little) return detail::host_load<std::uint32_t>(b, at);
   return static_cast<std::uint32_t>(b[at]) | (static_cast<std::uint32_t>(b[at + 1]) << 8) |
          (static_cast<std::uint32_t>(b[at + 2]) << 16) | (static_cast<std::uint32_t>(b[at + 3]) << 24);
 }
