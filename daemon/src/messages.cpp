@@ -119,7 +119,7 @@ void encode_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& head, s
   head.time_offset_ns.clear();
   const auto head_size = static_cast<std::size_t>(head.getEncodedSize());
   const std::size_t n = sweep.size();
-  out.resize(head_size + n * (4 * sizeof(std::uint32_t) + 3));
+  out.resize(head_size + n * kEncodedBytesPerPoint);
   std::uint8_t* p = out.data();
   (void)head.encode(p, 0, static_cast<int>(head_size));
   store_be32(p + head_size - 4, static_cast<std::uint32_t>(n));

@@ -20,9 +20,10 @@ Pipeline::Pipeline(const DaemonConfig& config_in, bool exact_in, bool recording)
     : config(config_in),
       exact(exact_in),
       sweeps(config_in.buffers.sweeps,
-             [&config_in] {
+             [&config_in, exact_in] {
                Sweep s;
                s.reserve(config_in.buffers.max_points_per_sweep, 4096);
+               if (!exact_in) s.make_resident();
                return s;
              }),
       status(std::make_unique<Ring<StatusSnapshot>>(8)),
@@ -34,10 +35,11 @@ Pipeline::Pipeline(const DaemonConfig& config_in, bool exact_in, bool recording)
 Pipeline::~Pipeline() = default;
 
 InputLane& Pipeline::add_input(std::unique_ptr<inputs::InputSource> source, std::size_t ring_capacity,
-                               std::string thread_name, const ThreadConfig& thread) {
+                               std::string thread_name, const ThreadConfig& thread, Lidar lidar) {
   auto lane = std::make_unique<InputLane>();
   lane->source = std::move(source);
   lane->ring = std::make_unique<Ring<InputSlot>>(ring_capacity);
+  if (lidar == Lidar::kMayCarry) lane->decoded = std::make_unique<Ring<vlp16::DecodedPacket>>(kDecodeAhead);
   lane->thread_name = std::move(thread_name);
   lane->thread = thread;
   inputs.push_back(std::move(lane));

@@ -85,8 +85,7 @@ struct InputLane {
   std::unique_ptr<inputs::InputSource> source;
   std::unique_ptr<Ring<InputSlot>> ring;
   // The points of the LiDAR data packets in `ring` that the input thread decoded ahead, in the
-  // same order (made by that thread the first time it decodes ahead, when the pipeline has a
-  // lidar_decoder).
+  // same order (made with the lane when its source may carry LiDAR data; else null).
   std::unique_ptr<Ring<vlp16::DecodedPacket>> decoded;
   std::string thread_name;  // "trajroid-lidar", …
   ThreadConfig thread;
@@ -105,14 +104,21 @@ struct StatusSnapshot;
 struct Pipeline {
   // `exact`: an as-fast-as-possible replay, where a full ring is waited on (the output is
   // the same on every run); otherwise a full ring drops the newest item and counts it.
+  // Otherwise, too, the sweeps' memory is made resident at start (Sweep::make_resident, here,
+  // in the processor and the publisher: about 25 MB at the default buffers, 12 ms on a VM), so
+  // that the daemon's memory is flat from its first sweep and no sweep takes a page fault; an
+  // as-fast replay, a batch job whose start-up is part of its time, lets it fault in as used.
   Pipeline(const DaemonConfig& config, bool exact, bool record);
   ~Pipeline();
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
 
-  // Adds a source and its ring (before the threads start).
+  // Adds a source and its ring (before the threads start). A source that may yield LiDAR data
+  // packets gets its ring of decoded packets here, every slot's memory touched, so that the
+  // first time its thread decodes ahead (a replay running behind, a flood) allocates nothing.
+  enum class Lidar : bool { kNone, kMayCarry };
   InputLane& add_input(std::unique_ptr<inputs::InputSource> source, std::size_t ring_capacity, std::string thread_name,
-                       const ThreadConfig& thread);
+                       const ThreadConfig& thread, Lidar lidar = Lidar::kMayCarry);
   [[nodiscard]] bool inputs_done() const noexcept;
   [[nodiscard]] bool inputs_empty() const noexcept;
 

@@ -277,7 +277,14 @@ void Publisher::run() {
   latency_window_ms_.reserve(4096);
   processing_window_ms_.reserve(4096);
   latency_minute_ms_.reserve(1U << 16);
-  points_.x.reserve(config_.buffers.max_points_per_sweep);  // and the others grow once
+  if (!pipeline_.exact) {
+    // The largest sweep's encoding, resident from the start (see Pipeline::exact; a page over
+    // for the head, whose size is that of an empty sweep's).
+    encode_points(Sweep{}, config_.pose_mode, points_, points_encoded_);
+    points_encoded_.resize(points_encoded_.size() + 4096 +
+                           config_.buffers.max_points_per_sweep * kEncodedBytesPerPoint);
+    points_encoded_.clear();
+  }
   bool final_seen = false;
   for (;;) {
     pipeline_.publishing_beat.fetch_add(1, std::memory_order_relaxed);

@@ -110,6 +110,17 @@ void place(const Eigen::Isometry3d& global_from_sensor, std::span<const vlp16::P
   roi::transform_points(global_from_sensor, placed, placed);
 }
 
+// Writes one element in every page of an empty array's capacity, so that its memory is
+// resident (see Sweep::make_resident).
+template <typename Array>
+void touch_capacity(Array& a) {
+  a.resize(a.capacity());  // default-initialised: nothing written yet
+  constexpr std::size_t kStride = 4096 / sizeof(typename Array::value_type);
+  for (std::size_t i = 0; i < a.size(); i += kStride)
+    a[i] = typename Array::value_type{};
+  a.clear();
+}
+
 }  // namespace
 
 pose_input::PoseInputConfig pose_input_config(const DaemonConfig& c) {
@@ -159,6 +170,17 @@ void Sweep::reserve(std::size_t points, std::size_t centre_count) {
   return_type.reserve(points);
   time_offset_ns.reserve(points);
   centres.reserve(centre_count);
+}
+
+void Sweep::make_resident() {
+  clear_points();
+  touch_capacity(x);
+  touch_capacity(y);
+  touch_capacity(z);
+  touch_capacity(intensity);
+  touch_capacity(ring);
+  touch_capacity(return_type);
+  touch_capacity(time_offset_ns);
 }
 
 void Sweep::clear_points() noexcept {

@@ -92,7 +92,8 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
     o.max_backoff = std::chrono::milliseconds(500);
     auto input = std::make_unique<inputs::SerialInput>(name, stream, o);
     if (s.configure) input->on_open(receiver_configuration(config, stream));
-    pipeline.add_input(std::move(input), config.buffers.serial_chunks, std::string("trajroid-") + name, thread);
+    pipeline.add_input(std::move(input), config.buffers.serial_chunks, std::string("trajroid-") + name, thread,
+                       Pipeline::Lidar::kNone);
   };
   // What the pose source reads (a device configured for an unused stream is left closed).
   if (config.pose_source == PoseSource::kGnssImu || config.pose_source == PoseSource::kGnss) {
@@ -103,7 +104,7 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
   if (config.pose_source == PoseSource::kLcm) {
     pipeline.add_input(std::make_unique<LcmPoseInput>(options.lcm_url.empty() ? config.lcm.url : options.lcm_url,
                                                       config.lcm.pose_input),
-                       config.buffers.serial_chunks, "trajroid-posein", config.realtime.gnss);
+                       config.buffers.serial_chunks, "trajroid-posein", config.realtime.gnss, Pipeline::Lidar::kNone);
   }
 }
 
@@ -225,6 +226,7 @@ int run_daemon(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> tra
     return processor->calibrate_scan();
   });
   const bool exact = options.replay.has_value() && options.rate == 0.0;
+  if (!exact) processor->make_resident();  // see Pipeline::exact
   Pipeline pipeline(config, exact, options.record.has_value());
   try {
     add_inputs(pipeline, config, options);

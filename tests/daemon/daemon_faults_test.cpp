@@ -293,11 +293,13 @@ TEST(TrajroidFaults, UdpFloodWithMalformedPacketsIsCountedBoundedAndRecoveredFro
       "RSS %ld kB before, %ld kB peak\n",
       static_cast<long long>(flood), static_cast<long long>(malformed), static_cast<long long>(data),
       static_cast<long long>(kernel), static_cast<long long>(ring), before_kb, peak_kb);
-  // Resident memory: every buffer is preallocated, so the flood does not grow it. (ASan's
-  // allocator quarantine grows on its own: not checked there.)
+  // Resident memory: every buffer is preallocated and made resident at start (the sweeps, the
+  // ring of packets decoded ahead, which a flood is the first to fill), so the flood does not
+  // grow it: a few pages at most (a lazily made 1.4 MB decode-ahead ring was +1.7 MB here).
+  // (ASan's allocator quarantine grows on its own: not checked there.)
   ASSERT_GT(before_kb, 0);
   if (!under_sanitizer()) {
-    EXPECT_LE(static_cast<double>(peak_kb), 1.05 * static_cast<double>(before_kb));
+    EXPECT_LE(peak_kb - before_kb, 256) << "kB of resident memory grown during the flood";
   }
 
   // Published through the flood (5 … 15 s; the scenario's own GNSS outage is 14 … 16 s),

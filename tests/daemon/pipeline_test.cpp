@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 #include <spdlog/sinks/ringbuffer_sink.h>
 #include <spdlog/spdlog.h>
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -201,6 +203,54 @@ TEST(Pipeline, ThreeFakeInputLanesThroughTheThreadsGiveTheProcessorsOwnSweeps) {
   EXPECT_EQ(last.ring_drops, 0);
   EXPECT_EQ(counter(last, "lidar.source_errors"), 3) << "one error said by each fake lane";
   EXPECT_EQ(last.sweeps_published, static_cast<std::int64_t>(published.size()));
+}
+
+// Whether every page wholly inside [data, data + bytes) is resident (mincore).
+bool resident(const void* data, std::size_t bytes) {
+  const auto page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
+  const std::uintptr_t first = (reinterpret_cast<std::uintptr_t>(data) + page - 1) / page * page;
+  const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) / page * page;
+  if (end <= first) return true;
+  std::vector<unsigned char> in((end - first) / page);
+  if (::mincore(reinterpret_cast<void*>(first), end - first, in.data()) != 0) return false;
+  return std::all_of(in.begin(), in.end(), [](unsigned char c) { return (c & 1U) != 0; });
+}
+
+template <typename Array>
+bool resident_capacity(const Array& a) {
+  return resident(a.data(), a.capacity() * sizeof(typename Array::value_type));
+}
+
+// Live (and a timed replay): the sweeps' arrays and a LiDAR lane's ring of packets decoded
+// ahead are allocated and resident before the first datagram, so a flood or a busier scene
+// grows neither the memory nor the page faults. A serial lane has no decode-ahead ring.
+TEST(Pipeline, SweepsAndTheDecodeAheadRingAreResidentFromTheStart) {
+  const DaemonConfig config = trajroi::daemon::load_daemon_config(corridor_run() / "trajroid.yaml");
+  Pipeline pipeline(config, /*exact=*/false, /*record=*/false);
+  const auto& lidar = pipeline.add_input(std::make_unique<FakeInput>(std::vector<Item>{}), 16, "test-lidar", {});
+  const auto& gnss =
+      pipeline.add_input(std::make_unique<FakeInput>(std::vector<Item>{}), 16, "test-gnss", {}, Pipeline::Lidar::kNone);
+  EXPECT_EQ(gnss.decoded, nullptr);
+  ASSERT_NE(lidar.decoded, nullptr);
+  std::size_t packets = 0;
+  while (lidar.decoded->try_push([&](trajroi::vlp16::DecodedPacket& d) {
+    EXPECT_TRUE(d.points.empty());
+    EXPECT_GE(d.points.capacity(), trajroi::vlp16::kPointsPerPacket);
+    EXPECT_TRUE(resident_capacity(d.points)) << "decoded packet " << packets;
+  }))
+    ++packets;
+  EXPECT_EQ(packets, lidar.decoded->capacity());
+  std::size_t sweeps = 0;
+  while (pipeline.sweeps.try_push([&](trajroi::daemon::Sweep& s) {
+    EXPECT_EQ(s.size(), 0U);
+    EXPECT_GE(s.x.capacity(), config.buffers.max_points_per_sweep);
+    const bool all = resident_capacity(s.x) && resident_capacity(s.y) && resident_capacity(s.z) &&
+                     resident_capacity(s.intensity) && resident_capacity(s.ring) && resident_capacity(s.return_type) &&
+                     resident_capacity(s.time_offset_ns);
+    EXPECT_TRUE(all) << "sweep slot " << sweeps;
+  }))
+    ++sweeps;
+  EXPECT_EQ(sweeps, pipeline.sweeps.capacity());
 }
 
 TEST(Pipeline, OneRecordedLaneIsExactlyTheProcessorsOutput) {

@@ -3,6 +3,7 @@
 // Between the daemon's values and its LCM messages (transport/lcmtypes): filling the outgoing
 // messages from a Sweep (reusing their vectors), and checking an incoming trajectory.
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -26,6 +27,9 @@ void fill_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& out);
 // arrays go from the sweep's vectors straight into the bytes: LCM's generated encoder swaps
 // them an element at a time. `head` is scratch for the fields before the arrays.
 void encode_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& head, std::vector<std::uint8_t>& out);
+// The bytes a point takes in that encoding: x, y, z, time offset and one each of intensity,
+// ring and return type.
+inline constexpr std::size_t kEncodedBytesPerPoint = 4 * sizeof(std::uint32_t) + 3;
 void fill_roi(const Sweep& sweep, trajroi::roi_t& out);
 
 // Why an incoming trajectory was refused (counted by reason in status_t).

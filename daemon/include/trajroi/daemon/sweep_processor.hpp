@@ -121,6 +121,10 @@ struct Sweep : SweepHeader {
   // indices are copied.
   void take(Sweep& other);
   void reserve(std::size_t points, std::size_t centres);
+  // Empties the sweep and writes a page of its arrays' capacity at a time, so that the reserved
+  // memory is resident: a sweep larger than any before it then takes no page fault, and a
+  // flood or a busier scene does not grow the resident memory.
+  void make_resident();
   void clear_points() noexcept;
   [[nodiscard]] std::size_t size() const noexcept { return x.size(); }
 };
@@ -162,6 +166,9 @@ class SweepProcessor {
   // the fastest on this machine the one used (roi::GridFilter::calibrate); at start, before
   // the first sweep.
   roi::ScanCalibration calibrate_scan() const;
+  // Makes the sweep it fills resident (Sweep::make_resident); at start, before the first
+  // datagram.
+  void make_resident() { sweep_.make_resident(); }
 
   // `decoded`: a data packet's points decoded ahead by packet_decoder() (vlp16::StreamDecoder::
   // on_data_packet), or null.

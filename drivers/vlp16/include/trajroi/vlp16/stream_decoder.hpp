@@ -123,8 +123,12 @@ inline constexpr std::uint32_t kFrameEndMargin_cdeg = 100;
 struct DecodedPacket {
   std::uint64_t tag = 0;
   PacketDecoder::Result result;
-  std::vector<Point> points;  // reserved for a whole packet: decoding into it never allocates
-  DecodedPacket() { points.reserve(kPointsPerPacket); }
+  // Room for a whole packet, its memory touched: decoding into it never allocates nor faults.
+  std::vector<Point> points;
+  DecodedPacket() {
+    points.resize(kPointsPerPacket);
+    points.clear();
+  }
 };
 
 class StreamDecoder {
