@@ -20,8 +20,12 @@ duration=$(awk '/^duration_s/ {print $2}' "$run/summary.txt")
 # the longest spell a fixed piece of arithmetic ran over twice as slow as at full speed, and how
 # slow; a latency tail measured during such a spell is the machine's.
 steady="$(dirname "$run")/steady.txt"
-figures() {  # rate → "latency_p50 latency_p99 drops wall_s cpu_s pipeline_cpu_s spell_ms spell_factor run_s"
-  local log start end witness=
+# The host's steal over a run (/proc/stat, all CPUs, ms): time the hypervisor gave this VM's
+# CPUs to others while they had work.
+steal_ms() { awk -v hz="$(getconf CLK_TCK)" '/^cpu / {printf "%.0f", $9 * 1000 / hz}' /proc/stat; }
+figures() {  # rate → "latency_p50 latency_p99 drops wall_s cpu_s pipeline_cpu_s spell_ms spell_factor run_s steal_ms"
+  local log start end witness= steal0
+  steal0=$(steal_ms)
   if [ "$1" = realtime ]; then
     "$build/tools/trajroi" machine --seconds "$duration" --brief >"$steady" 2>/dev/null &
     witness=$!
@@ -47,7 +51,7 @@ figures() {  # rate → "latency_p50 latency_p99 drops wall_s cpu_s pipeline_cpu
   if [ -n "$witness" ]; then
     wait "$witness" && spell=$(awk '{print $1, $2}' "$steady")
   fi
-  echo "$p50 $p99 $drops $wall $(awk -v u="$user" -v s="$sys" 'BEGIN {print u + s}') $pipeline $spell $run_s"
+  echo "$p50 $p99 $drops $wall $(awk -v u="$user" -v s="$sys" 'BEGIN {print u + s}') $pipeline $spell $run_s $(($(steal_ms) - steal0))"
 }
 
 echo "scenario: tests/daemon/corridor.yaml, dual return, ${duration} s of data"
@@ -81,3 +85,10 @@ awk -v w="$wall" -v d="$duration" -v x="$drops" -v n="$runs" -v each="$(awk '{pr
 inside=$(awk '{print $9}' <<<"$fast" | median)
 awk -v r="$inside" -v w="$wall" -v d="$duration" \
   'BEGIN {printf "as fast as possible: the run inside the daemon (its summary) %.3f s = %.0fx (median), start-up and exit of the process %.3f s\n", r, d / r, w - r}'
+# The work against the machine: the whole process's CPU (user + system, every thread) spread
+# perfectly over every core is the shortest wall time this build could have here; steal is
+# the time the host took the VM's CPUs away meanwhile.
+cpu=$(awk '{print $5}' <<<"$fast" | median)
+cores=$(nproc)
+awk -v c="$cpu" -v n="$cores" -v d="$duration" -v w="$wall" -v st="$(awk '{printf "%s ", $10}' <<<"$fast")" \
+  'BEGIN {printf "as fast as possible: CPU of the whole process %.3f s (median) = %.0f %% of %d cores over the wall; spread perfectly over them it needs %.3f s = %.0fx at most; the host'"'"'s steal each run: %sms\n", c, 100 * c / (n * w), n, c / n, d * n / c, st}'

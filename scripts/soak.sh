@@ -71,7 +71,11 @@ else
   echo "soak: cyclictest not installed (apt-get install rt-tests): no witness of the machine's own wake-up delays"
 fi
 echo "soak: corridor run (${lap_s} s of dual-return data a lap) looped at ${rate}x real time for ${minutes} min"
-echo "soak: machine: $(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1), $(nproc) cores"
+# The CPU as the figures elsewhere name it: model name, and on x86 family and model numbers
+# (a VM's generic name hides which processor it is).
+cpu=$(awk -F'\t*: ' '$1 == "model name" && !n {n = $2} $1 == "cpu family" && !f {f = $2} $1 == "model" && m == "" {m = $2}
+  END {printf "%s", n; if (f != "" && m != "") printf " (family %s model %s)", f, m}' /proc/cpuinfo)
+echo "soak: machine: ${cpu}, $(nproc) cores"
 printf '%-6s %9s %8s %9s %10s %10s %10s %10s %10s %10s\n' minute "RSS MiB" sweeps published "p50 ms" "p99 ms" "max ms" \
   "ring drop" "kern drop" "steal ms"
 # Steal: CPU time the hypervisor gave to others while this machine's CPUs wanted it (all CPUs,

@@ -4,6 +4,8 @@
 
 #include <cstdio>
 #include <fstream>
+#include <istream>
+#include <string_view>
 
 namespace trajroi::roi {
 
@@ -21,18 +23,35 @@ std::string describe(const ScanCalibration& calibration) {
   return text + " (" + times + " ns per point)";
 }
 
-std::string cpu_model() {
-  std::ifstream info("/proc/cpuinfo");
+std::string cpu_model_from(std::istream& cpuinfo) {
+  std::string name, family, model;
   std::string line;
-  while (std::getline(info, line)) {
-    if (line.starts_with("model name") || line.starts_with("Model") || line.starts_with("CPU part")) {
-      const std::size_t colon = line.find(':');
-      if (colon == std::string::npos) continue;
-      const std::size_t start = line.find_first_not_of(" \t", colon + 1);
-      if (start != std::string::npos) return line.substr(start);
+  const auto value = [&line] {
+    const std::size_t colon = line.find(':');
+    if (colon == std::string::npos) return std::string();
+    const std::size_t start = line.find_first_not_of(" \t", colon + 1);
+    return start == std::string::npos ? std::string() : line.substr(start);
+  };
+  while (std::getline(cpuinfo, line)) {
+    const auto field = [&line](std::string_view key) {
+      return line.starts_with(key) && line.find_first_not_of(" \t", key.size()) == line.find(':');
+    };
+    if (name.empty() && (field("model name") || field("Model") || field("CPU part"))) {
+      name = value();
+    } else if (family.empty() && field("cpu family")) {
+      family = value();
+    } else if (model.empty() && field("model")) {
+      model = value();
     }
   }
-  return "unknown CPU";
+  if (name.empty()) return "unknown CPU";
+  if (!family.empty() && !model.empty()) name += " (family " + family + " model " + model + ")";
+  return name;
+}
+
+std::string cpu_model() {
+  std::ifstream info("/proc/cpuinfo");
+  return cpu_model_from(info);
 }
 
 unsigned usable_cores() {

@@ -3,6 +3,8 @@
 
 #include <limits>
 #include <random>
+#include <sstream>
+#include <string>
 
 #include "trajroi/roi/cpu.hpp"
 #include "trajroi/roi/grid_filter.hpp"
@@ -93,6 +95,27 @@ TEST(ScanCalibration, TheMachineIsNamed) {
   EXPECT_FALSE(model.empty());
   EXPECT_GE(usable_cores(), 1u);
   EXPECT_NE(describe_machine().find(std::to_string(usable_cores()) + " cores"), std::string::npos);
+}
+
+// The name and, on x86, the family and model numbers (what tells one generic VM name's
+// processors apart), from the first processor's block; ARM has neither number.
+TEST(ScanCalibration, TheModelLineCarriesFamilyAndModel) {
+  const auto model_of = [](const std::string& text) {
+    std::istringstream in(text);
+    return cpu_model_from(in);
+  };
+  EXPECT_EQ(model_of("processor\t: 0\nvendor_id\t: AuthenticAMD\ncpu family\t: 25\nmodel\t\t: 17\n"
+                     "model name\t: AMD EPYC\nstepping\t: 0\n\nprocessor\t: 1\ncpu family\t: 26\nmodel\t\t: 2\n"
+                     "model name\t: other\n"),
+            "AMD EPYC (family 25 model 17)");
+  EXPECT_EQ(model_of("processor\t: 0\nvendor_id\t: GenuineIntel\ncpu family\t: 6\nmodel\t\t: 207\n"
+                     "model name\t: Intel(R) Xeon(R) Processor\n"),
+            "Intel(R) Xeon(R) Processor (family 6 model 207)");
+  EXPECT_EQ(model_of("processor\t: 0\nBogoMIPS\t: 108.00\nCPU implementer\t: 0x41\nCPU part\t: 0xd08\n\n"
+                     "Model\t\t: Raspberry Pi 4 Model B Rev 1.4\n"),
+            "0xd08");
+  EXPECT_EQ(model_of("processor\t: 0\ncpu family\t: 6\nmodel\t\t: 85\n"), "unknown CPU");
+  EXPECT_EQ(model_of(""), "unknown CPU");
 }
 
 }  // namespace
