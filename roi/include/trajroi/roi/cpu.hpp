@@ -18,7 +18,7 @@ namespace trajroi::roi {
 // the numbers tell apart (Zen 3 is family 25 model 1, Zen 4 model 17). "unknown CPU" without
 // a name.
 [[nodiscard]] std::string cpu_model();
-// The same from a /proc/cpuinfo text (the first of each line: the first processor's).
+// The same from a /proc/cpuinfo text (each field's first occurrence: the first processor's).
 [[nodiscard]] std::string cpu_model_from(std::istream& cpuinfo);
 // The cores this process may run on (its affinity mask).
 [[nodiscard]] unsigned usable_cores();
