@@ -10,6 +10,8 @@
 set -euo pipefail
 export LC_NUMERIC=C  # EPOCHREALTIME and awk agree on the decimal point
 cd "$(dirname "$0")/.."
+# shellcheck source=scripts/lib/host.sh
+. scripts/lib/host.sh  # steal_ms: the host's steal over each run
 build=${1:-build/release}
 run=$(mktemp -d)/corridor
 trap 'rm -rf "$(dirname "$run")"' EXIT
@@ -20,9 +22,6 @@ duration=$(awk '/^duration_s/ {print $2}' "$run/summary.txt")
 # the longest spell a fixed piece of arithmetic ran over twice as slow as at full speed, and how
 # slow; a latency tail measured during such a spell is the machine's.
 steady="$(dirname "$run")/steady.txt"
-# The host's steal over a run (/proc/stat, all CPUs, ms): time the hypervisor gave this VM's
-# CPUs to others while they had work.
-steal_ms() { awk -v hz="$(getconf CLK_TCK)" '/^cpu / {printf "%.0f", $9 * 1000 / hz}' /proc/stat; }
 figures() {  # rate → "latency_p50 latency_p99 drops wall_s cpu_s pipeline_cpu_s spell_ms spell_factor run_s steal_ms"
   local log start end witness= steal0
   steal0=$(steal_ms)

@@ -14,6 +14,8 @@
 # Usage: scripts/soak.sh [MINUTES=10] [RATE=10] [BUILD_DIR=build/release]
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=scripts/lib/host.sh
+. scripts/lib/host.sh
 minutes=${1:-10}
 rate=${2:-10}
 build=${3:-build/release}
@@ -71,16 +73,11 @@ else
   echo "soak: cyclictest not installed (apt-get install rt-tests): no witness of the machine's own wake-up delays"
 fi
 echo "soak: corridor run (${lap_s} s of dual-return data a lap) looped at ${rate}x real time for ${minutes} min"
-# The CPU as the figures elsewhere name it: model name, and on x86 family and model numbers
-# (a VM's generic name hides which processor it is).
-cpu=$(awk -F'\t*: ' '$1 == "model name" && !n {n = $2} $1 == "cpu family" && !f {f = $2} $1 == "model" && m == "" {m = $2}
-  END {printf "%s", n; if (f != "" && m != "") printf " (family %s model %s)", f, m}' /proc/cpuinfo)
-echo "soak: machine: ${cpu}, $(nproc) cores"
+echo "soak: machine: $(machine_name "$build")"
 printf '%-6s %9s %8s %9s %10s %10s %10s %10s %10s %10s\n' minute "RSS MiB" sweeps published "p50 ms" "p99 ms" "max ms" \
   "ring drop" "kern drop" "steal ms"
 # Steal: CPU time the hypervisor gave to others while this machine's CPUs wanted it (all CPUs,
 # /proc/stat), during that minute; a virtual machine's tail latency follows it.
-steal_ms() { awk '/^cpu / {printf "%d", $9 * 1000 / '"$(getconf CLK_TCK)"'}' /proc/stat; }
 steal_before=$(steal_ms)
 maxima=()
 rss_mib() { awk '/^VmRSS:/ {printf "%.1f", $2 / 1024}' "/proc/$daemon_pid/status"; }
