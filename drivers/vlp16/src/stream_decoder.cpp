@@ -25,6 +25,44 @@ double wrapped_deg(double deg) noexcept {
   return r >= 360.0 ? 0.0 : r;
 }
 
+// A point's azimuth past the cut, [0, 360) (the frame's order).
+inline double phase_deg(float azimuth_deg, double cut_deg) noexcept {
+  double phase = static_cast<double>(azimuth_deg) - cut_deg;
+  if (phase < 0.0) phase += 360.0;
+  return phase;
+}
+
+// A packet's points [0, count) placed on the frame in one pass, when none of them can end it:
+// all on one side of the cut, within half a turn of one another and of the point before them
+// (`last_phase_deg`), and within kMaxFrameDuration_ns of the frame's start. The point-by-point
+// loop in accept() would then neither break nor do anything else than this: the same time
+// offsets, end time and last phase, to the bit. Answers false, having written nothing, for a
+// packet that may end the frame (about one per sweep), which then takes that loop.
+bool place_whole_packet(Point* p, std::size_t count, std::int64_t time_ns, std::int64_t start_ns, double cut_deg,
+                        double& last_phase_deg, std::int64_t& end_time_ns) noexcept {
+  if (count == 0) return false;
+  float az_min = p[0].azimuth_deg;
+  float az_max = az_min;
+  std::uint32_t offset_max = p[0].time_offset_ns;
+  for (std::size_t k = 1; k < count; ++k) {
+    az_min = std::min(az_min, p[k].azimuth_deg);
+    az_max = std::max(az_max, p[k].azimuth_deg);
+    offset_max = std::max(offset_max, p[k].time_offset_ns);
+  }
+  // On one side of the cut the phase grows with the azimuth (each step rounds monotonically),
+  // so the extreme azimuths give the extreme phases.
+  if ((static_cast<double>(az_min) - cut_deg < 0.0) != (static_cast<double>(az_max) - cut_deg < 0.0)) return false;
+  const double phase_min = phase_deg(az_min, cut_deg);
+  const double phase_max = phase_deg(az_max, cut_deg);
+  if (phase_min < phase_max - 180.0 || phase_min < last_phase_deg - 180.0) return false;
+  const std::int64_t t_max = time_ns + offset_max;
+  if (t_max - start_ns > kMaxFrameDuration_ns) return false;
+  for (std::size_t k = 0; k < count; ++k)
+    p[k].time_offset_ns = static_cast<std::uint32_t>(time_ns + p[k].time_offset_ns - start_ns);
+  end_time_ns = std::max(end_time_ns, t_max);
+  last_phase_deg = phase_deg(p[count - 1].azimuth_deg, cut_deg);
+  return true;
+}
 }  // namespace
 
 std::uint16_t cut_centidegrees(double cut_azimuth_deg) noexcept {
@@ -223,9 +261,9 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
       const std::int64_t start_ns = frame_.start_time_ns;
       const double cut_deg = options_.cut_azimuth_deg;
       const std::size_t from = i;
+      if (place_whole_packet(p + i, n - i, time_ns, start_ns, cut_deg, last_phase_deg, end_time_ns)) i = n;
       for (; i < n; ++i) {
-        double phase = static_cast<double>(p[i].azimuth_deg) - cut_deg;
-        if (phase < 0.0) phase += 360.0;
+        const double phase = phase_deg(p[i].azimuth_deg, cut_deg);
         const std::int64_t t = time_ns + p[i].time_offset_ns;
         if (phase < last_phase_deg - 180.0 || t - start_ns > kMaxFrameDuration_ns) break;
         last_phase_deg = phase;
@@ -238,8 +276,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
       }
       if (i == n) break;
     }
-    double phase = static_cast<double>(points[i].azimuth_deg) - options_.cut_azimuth_deg;
-    if (phase < 0.0) phase += 360.0;
+    const double phase = phase_deg(points[i].azimuth_deg, options_.cut_azimuth_deg);
     const std::int64_t t = time_ns + points[i].time_offset_ns;
     const bool cut = have_phase && phase < last_phase_deg - 180.0;
     if (cut || (i > 0 && t - frame_.start_time_ns > kMaxFrameDuration_ns)) {

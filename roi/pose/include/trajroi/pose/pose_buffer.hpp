@@ -203,6 +203,10 @@ class FiringPoses {
   [[nodiscard]] bool covers(std::int64_t t_ns) const noexcept {
     return have_ && t_ns >= query_ns_ && t_ns - query_ns_ < period_ns_;
   }
+  // The last query's time and the period its pose is kept for: covers(t) is
+  // t − query_ns() ∈ [0, period_ns()) once a query was made.
+  [[nodiscard]] std::int64_t query_ns() const noexcept { return query_ns_; }
+  [[nodiscard]] std::int64_t period_ns() const noexcept { return period_ns_; }
   // The last query's failing figure and its limit (PoseQuery::measured, limit).
   [[nodiscard]] double measured() const noexcept { return measured_; }
   [[nodiscard]] double limit() const noexcept { return limit_; }
