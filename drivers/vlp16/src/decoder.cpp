@@ -192,6 +192,34 @@ __attribute__((always_inline)) inline void PacketDecoder::directions(std::uint16
   }
 }
 
+namespace {
+
+// [lo, hi] widened to hold every azimuth of a firing: the azimuth bounds of a decode() (those of
+// every channel, four at a time; none is NaN).
+__attribute__((always_inline)) inline void widen_azimuth_bounds(const std::array<float, kChannels>& azimuth_deg,
+                                                                float& lo, float& hi) noexcept {
+#if defined(__SSE2__)
+  __m128 min4 = _mm_loadu_ps(&azimuth_deg[0]);
+  __m128 max4 = min4;
+  for (std::size_t channel = 4; channel < kChannels; channel += 4) {
+    const __m128 a = _mm_loadu_ps(&azimuth_deg[channel]);
+    min4 = _mm_min_ps(min4, a);
+    max4 = _mm_max_ps(max4, a);
+  }
+  min4 = _mm_min_ps(min4, _mm_movehl_ps(min4, min4));
+  max4 = _mm_max_ps(max4, _mm_movehl_ps(max4, max4));
+  lo = std::min(lo, _mm_cvtss_f32(_mm_min_ss(min4, _mm_shuffle_ps(min4, min4, 1))));
+  hi = std::max(hi, _mm_cvtss_f32(_mm_max_ss(max4, _mm_shuffle_ps(max4, max4, 1))));
+#else
+  for (const float a : azimuth_deg) {
+    lo = std::min(lo, a);
+    hi = std::max(hi, a);
+  }
+#endif
+}
+
+}  // namespace
+
 PacketDecoder::Result PacketDecoder::decode(std::span<const std::uint8_t> packet, std::vector<Point>& out) const {
   static const bool avx2 = decoder_calibration().chosen == DecoderBuild::kAvx2;
   return avx2 ? decode_avx2(packet, out) : decode_baseline(packet, out);
@@ -243,6 +271,8 @@ __attribute__((always_inline)) inline PacketDecoder::Result PacketDecoder::decod
                                                      : azimuth_gap(block_azimuth(packet, block - step), azimuth);
     directions(azimuth, gap, d);
     const auto& time_ns = time_ns_[block / step];
+    widen_azimuth_bounds(d.azimuth_deg, result.azimuth_min_deg, result.azimuth_max_deg);
+    result.time_offset_max_ns = std::max(result.time_offset_max_ns, time_ns[kChannels - 1]);
 
     for (std::size_t channel = 0; channel < kChannels; ++channel) {
       // The returns of this firing: one, or in dual mode the last (even block) and strongest.

@@ -36,30 +36,28 @@ inline double phase_deg(float azimuth_deg, double cut_deg) noexcept {
 // all on one side of the cut, within half a turn of one another and of the point before them
 // (`last_phase_deg`), and within kMaxFrameDuration_ns of the frame's start. The point-by-point
 // loop in accept() would then neither break nor do anything else than this: the same time
-// offsets, end time and last phase, to the bit. Answers false, having written nothing, for a
-// packet that may end the frame (about one per sweep), which then takes that loop.
-bool place_whole_packet(Point* p, std::size_t count, std::int64_t time_ns, std::int64_t start_ns, double cut_deg,
-                        double& last_phase_deg, std::int64_t& end_time_ns) noexcept {
+// offsets, end time and last phase, to the bit. `bounds`: the decode's azimuth and time offset
+// bounds, which hold every point's. Answers false, having written nothing, for a packet that
+// may end the frame (about one per sweep), which then takes that loop.
+bool place_whole_packet(Point* p, std::size_t count, const PacketDecoder::Result& bounds, std::int64_t time_ns,
+                        std::int64_t start_ns, double cut_deg, double& last_phase_deg,
+                        std::int64_t& end_time_ns) noexcept {
   if (count == 0) return false;
-  float az_min = p[0].azimuth_deg;
-  float az_max = az_min;
-  std::uint32_t offset_max = p[0].time_offset_ns;
-  for (std::size_t k = 1; k < count; ++k) {
-    az_min = std::min(az_min, p[k].azimuth_deg);
-    az_max = std::max(az_max, p[k].azimuth_deg);
-    offset_max = std::max(offset_max, p[k].time_offset_ns);
-  }
+  const float az_min = bounds.azimuth_min_deg;
+  const float az_max = bounds.azimuth_max_deg;
   // On one side of the cut the phase grows with the azimuth (each step rounds monotonically),
-  // so the extreme azimuths give the extreme phases.
+  // so the bounds' phases bound the points'.
   if ((static_cast<double>(az_min) - cut_deg < 0.0) != (static_cast<double>(az_max) - cut_deg < 0.0)) return false;
   const double phase_min = phase_deg(az_min, cut_deg);
   const double phase_max = phase_deg(az_max, cut_deg);
   if (phase_min < phase_max - 180.0 || phase_min < last_phase_deg - 180.0) return false;
-  const std::int64_t t_max = time_ns + offset_max;
-  if (t_max - start_ns > kMaxFrameDuration_ns) return false;
-  for (std::size_t k = 0; k < count; ++k)
+  if (time_ns + bounds.time_offset_max_ns - start_ns > kMaxFrameDuration_ns) return false;
+  std::uint32_t offset_max = 0;
+  for (std::size_t k = 0; k < count; ++k) {
+    offset_max = std::max(offset_max, p[k].time_offset_ns);
     p[k].time_offset_ns = static_cast<std::uint32_t>(time_ns + p[k].time_offset_ns - start_ns);
-  end_time_ns = std::max(end_time_ns, t_max);
+  }
+  end_time_ns = std::max(end_time_ns, time_ns + offset_max);
   last_phase_deg = phase_deg(p[count - 1].azimuth_deg, cut_deg);
   return true;
 }
@@ -246,7 +244,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   // frame. The loop keeps its state in locals, written back around the rare end of a frame.
   std::vector<Point>& points = frame_.points;
   std::size_t i = points.size();
-  decode_onto_frame(packet, decoded);
+  const PacketDecoder::Result decoded_bounds = decode_onto_frame(packet, decoded);
   std::int64_t end_time_ns = frame_.end_time_ns;
   double last_phase_deg = last_phase_deg_;
   bool have_phase = have_phase_;
@@ -261,7 +259,8 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
       const std::int64_t start_ns = frame_.start_time_ns;
       const double cut_deg = options_.cut_azimuth_deg;
       const std::size_t from = i;
-      if (place_whole_packet(p + i, n - i, time_ns, start_ns, cut_deg, last_phase_deg, end_time_ns)) i = n;
+      if (place_whole_packet(p + i, n - i, decoded_bounds, time_ns, start_ns, cut_deg, last_phase_deg, end_time_ns))
+        i = n;
       for (; i < n; ++i) {
         const double phase = phase_deg(p[i].azimuth_deg, cut_deg);
         const std::int64_t t = time_ns + p[i].time_offset_ns;
@@ -311,7 +310,8 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   report_points(sink);
 }
 
-void StreamDecoder::decode_onto_frame(std::span<const std::uint8_t> packet, const DecodedPacket* decoded) {
+PacketDecoder::Result StreamDecoder::decode_onto_frame(std::span<const std::uint8_t> packet,
+                                                       const DecodedPacket* decoded) {
   std::vector<Point>& points = frame_.points;
   PacketDecoder::Result r;
   if (decoded != nullptr) {
@@ -327,6 +327,7 @@ void StreamDecoder::decode_onto_frame(std::span<const std::uint8_t> packet, cons
   counters_.no_return += r.no_return;
   counters_.out_of_range += r.out_of_range;
   counters_.merged_returns += r.merged_returns;
+  return r;
 }
 
 void StreamDecoder::report_points(FrameSink& sink) {
@@ -344,7 +345,7 @@ void StreamDecoder::append_late(std::span<const std::uint8_t> packet, std::int64
     return;
   }
   const std::size_t first = frame_.points.size();
-  decode_onto_frame(packet, decoded);
+  (void)decode_onto_frame(packet, decoded);
   ++frame_.packets;
   for (std::size_t i = first; i < frame_.points.size(); ++i) {
     Point& point = frame_.points[i];

@@ -121,6 +121,11 @@ class PacketDecoder {
     std::size_t out_of_range = 0;    // outside [min_range, max_range]
     std::size_t merged_returns = 0;  // dual mode: second returns identical to the first
     // points + no_return + out_of_range + merged_returns = 384 per packet
+    // Bounds of the azimuths and time offsets of every channel of every firing decoded, points
+    // or not (those of the points lie within; nothing decoded: +inf, −inf, 0).
+    float azimuth_min_deg = std::numeric_limits<float>::infinity();
+    float azimuth_max_deg = -std::numeric_limits<float>::infinity();
+    std::uint32_t time_offset_max_ns = 0;
   };
 
   // Appends the points of one packet that validate_data_packet() accepted. Never reads

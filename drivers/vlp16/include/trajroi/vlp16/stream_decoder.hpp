@@ -167,7 +167,7 @@ class StreamDecoder {
               const DecodedPacket* decoded);
   // Appends the packet's points to the frame (time after the packet's first firing), decoded
   // here or ahead, and counts them.
-  void decode_onto_frame(std::span<const std::uint8_t> packet, const DecodedPacket* decoded);
+  PacketDecoder::Result decode_onto_frame(std::span<const std::uint8_t> packet, const DecodedPacket* decoded);
   void append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns, FrameSink& sink,
                    const DecodedPacket* decoded);
   std::int64_t packet_time_ns(std::uint32_t toh_us, std::int64_t receive_time_ns, double period_us);
