@@ -451,13 +451,10 @@ pose::PoseStatus SweepProcessor::filter_batch(const vlp16::Frame& frame, std::si
       pose::PoseStatus status{};
       const Eigen::Isometry3d* pose = firing_.at(frame.start_time_ns + frame.points[i].time_offset_ns, status);
       if (pose == nullptr) return status;
-      // The points the same pose covers (FiringPoses::covers), in the frame's time offsets:
-      // offset − (query − frame start) ∈ [0, period), one unsigned comparison per point.
-      const std::int64_t query_offset_ns = firing_.query_ns() - frame.start_time_ns;
-      const auto period_ns = static_cast<std::uint64_t>(firing_.period_ns());
+      // The following points the same pose covers, in the frame's time offsets.
+      const pose::FiringPoses::Window window = firing_.window_after(frame.start_time_ns);
       std::size_t j = i + 1;
-      while (j < end &&
-             static_cast<std::uint64_t>(std::int64_t{frame.points[j].time_offset_ns} - query_offset_ns) < period_ns)
+      while (j < end && window.contains(frame.points[j].time_offset_ns))
         ++j;
       place_run(i, j, *pose);
       i = j;

@@ -203,7 +203,7 @@ TEST_F(Cli, MachineReportsEveryCoreAndRefusesBadSettings) {
   ASSERT_TRUE(fields >> longest_ms >> worst >> slow_ms) << brief.out;
   EXPECT_GE(longest_ms, 0.0);
   EXPECT_LE(longest_ms, slow_ms + 1e-9);
-  // A spell is over 2x full speed; printed with one decimal, one just over 2x reads 2.0.
+  // A spell is over 2x full speed; printed to 0.01, one just over 2x reads 2.00.
   EXPECT_TRUE(worst == 0.0 || worst >= 2.0) << "a spell is over 2x full speed: " << brief.out;
 
   for (const char* bad : {"--seconds 0", "--every-ms -1", "--piece-us 6000 --every-ms 5"}) {

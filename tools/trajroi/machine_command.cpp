@@ -121,8 +121,9 @@ int run_machine(const MachineOptions& o) {
     worst = std::max(worst, s.worst_factor());
     slow = std::max(slow, s.slow_ms());
   }
-  if (o.brief) {  // for scripts: the longest spell (ms), the worst factor, the most slow time of a core (ms)
-    std::printf("%.1f %.1f %.1f\n", longest, worst, slow);
+  if (o.brief) {  // for scripts: the longest spell (ms), the worst factor, the most slow time of a core (ms);
+    // the factor to 0.01, so that a spell just over 2x does not read as 2x
+    std::printf("%.1f %.2f %.1f\n", longest, worst, slow);
     return 0;
   }
   const bool fifo = std::all_of(timers.begin(), timers.end(), [](const Timer& t) { return t.fifo; });

@@ -173,10 +173,24 @@ class FiringPoses {
   FiringPoses(const PoseBuffer& buffer, const Eigen::Isometry3d& robot_from_sensor, std::int64_t period_ns) noexcept
       : buffer_(&buffer), robot_from_sensor_(robot_from_sensor), period_ns_(period_ns) {}
 
+  // The times the last query's pose is kept for, [t_query, t_query + period), as offsets after
+  // a base time (a frame's start: its points carry such offsets): one unsigned comparison each.
+  struct Window {
+    std::int64_t first_ns;
+    std::uint64_t period_ns;
+    [[nodiscard]] bool contains(std::int64_t offset_ns) const noexcept {
+      return static_cast<std::uint64_t>(offset_ns - first_ns) < period_ns;
+    }
+  };
+  // Meaningful once at() has made a query.
+  [[nodiscard]] Window window_after(std::int64_t base_ns) const noexcept {
+    return {query_ns_ - base_ns, static_cast<std::uint64_t>(period_ns_)};
+  }
+
   // global_from_sensor at t, or nullptr when the pose is not valid (`status` says why). A new
-  // query is made when t leaves [t_query, t_query + period) (covers() says whether it would).
+  // query is made when t leaves the last query's window.
   [[nodiscard]] const Eigen::Isometry3d* at(std::int64_t t_ns, PoseStatus& status) noexcept {
-    if (!have_ || t_ns < query_ns_ || t_ns - query_ns_ >= period_ns_) {
+    if (!have_ || !window_after(0).contains(t_ns)) {
       const PoseQuery q = buffer_->pose_at(t_ns);
       status_ = q.status;
       measured_ = q.measured;
@@ -199,14 +213,6 @@ class FiringPoses {
     }
     global_from_sensor_.translation() = turned_sensor_offset_ + global_from_robot.translation();
   }
-  // Whether at(t) would answer the last query's pose without a new one.
-  [[nodiscard]] bool covers(std::int64_t t_ns) const noexcept {
-    return have_ && t_ns >= query_ns_ && t_ns - query_ns_ < period_ns_;
-  }
-  // The last query's time and the period its pose is kept for: covers(t) is
-  // t − query_ns() ∈ [0, period_ns()) once a query was made.
-  [[nodiscard]] std::int64_t query_ns() const noexcept { return query_ns_; }
-  [[nodiscard]] std::int64_t period_ns() const noexcept { return period_ns_; }
   // The last query's failing figure and its limit (PoseQuery::measured, limit).
   [[nodiscard]] double measured() const noexcept { return measured_; }
   [[nodiscard]] double limit() const noexcept { return limit_; }
