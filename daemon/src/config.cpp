@@ -117,6 +117,19 @@ std::optional<LcmGroup> lcm_multicast_group(const std::string& url) {
   group.address = target.substr(0, colon);
   if (group.address.empty()) group.address = "239.255.76.67";
   if (colon != std::string::npos) group.port = std::stoi(target.substr(colon + 1));
+  const std::size_t question = rest.find('?');
+  std::size_t at = question == std::string::npos ? rest.size() : question + 1;
+  while (at < rest.size()) {  // options as check_lcm_url accepts them; others are ignored here
+    const std::size_t end = std::min(rest.find('&', at), rest.size());
+    const std::string option = rest.substr(at, end - at);
+    const std::size_t eq = option.find('=');
+    const std::string value = eq == std::string::npos ? "" : option.substr(eq + 1);
+    const bool number =
+        !value.empty() && value.size() <= 9 && value.find_first_not_of("0123456789") == std::string::npos;
+    if (number && option.starts_with("ttl=")) group.ttl = std::stoi(value);
+    if (number && option.starts_with("recv_buf_size=")) group.recv_buf_size = std::stoi(value);
+    at = end + 1;
+  }
   return group;
 }
 

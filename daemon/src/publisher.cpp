@@ -48,15 +48,16 @@ Publisher::Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, boo
       sweep_warn_limit_(pipeline.config.logging.warning_interval_s),
       trajectory_warn_limit_(pipeline.config.logging.warning_interval_s),
       late_limit_(pipeline.config.logging.warning_interval_s) {
-  // Here, before the loops start: LCM's first subscription runs its self test (up to seconds
-  // when its own multicast does not come back), which must not hold up the publishing loop.
+  // Here, before the loops start: the subscription first checks that this process's own
+  // multicast comes back (up to half a second when it does not), which must not hold up the
+  // publishing loop.
   const bool receiving = outlet_.subscribe(config_.lcm.trajectory,
                                            [this](std::span<const std::uint8_t> bytes, const std::string& channel) {
                                              on_trajectory_message(bytes, channel);
                                            });
   if (!receiving) {
     log::error(
-        "LCM: this process does not receive its own multicast (the self test failed): trajectory messages on {} "
+        "LCM: this process does not receive its own multicast (its probe did not come back): trajectory messages on {} "
         "will not arrive. Under systemd the unit's IPAddressAllow= must admit this host's addresses "
         "(trajroid --unit-drop-in); otherwise check the multicast route and the firewall",
         config_.lcm.trajectory);

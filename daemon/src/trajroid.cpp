@@ -59,7 +59,9 @@ inputs::SerialInput::OnOpen receiver_configuration(const DaemonConfig& config, i
 }
 
 // The live sensors, or the recorded run: the only difference between live and replay.
-void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions& options) {
+// `own_source`: the source of the daemon's own LCM datagrams, which an input over LCM leaves out.
+void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions& options,
+                const std::optional<sockaddr_in>& own_source) {
   if (options.replay) {
     inputs::RecordedOptions recorded;
     recorded.rate = options.rate;
@@ -103,7 +105,7 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
     add_serial(config.imu, "imu", inputs::Stream::kImu, config.realtime.imu);
   if (config.pose_source == PoseSource::kLcm) {
     pipeline.add_input(std::make_unique<LcmPoseInput>(options.lcm_url.empty() ? config.lcm.url : options.lcm_url,
-                                                      config.lcm.pose_input),
+                                                      config.lcm.pose_input, own_source),
                        config.buffers.serial_chunks, "trajroid-posein", config.realtime.gnss, Pipeline::Lidar::kNone);
   }
 }
@@ -228,18 +230,20 @@ int run_daemon(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> tra
   const bool exact = options.replay.has_value() && options.rate == 0.0;
   if (!exact) processor->make_resident();  // see Pipeline::exact
   Pipeline pipeline(config, exact, options.record.has_value());
-  try {
-    add_inputs(pipeline, config, options);
-  } catch (const std::exception& e) {
-    log::critical("cannot open the sources: {}", e.what());
-    return 1;
-  }
+  // The outlet first: an input over LCM leaves out the outlet's own datagrams.
   const std::string url = options.lcm_url.empty() ? config.lcm.url : options.lcm_url;
-  std::unique_ptr<LcmOutlet> outlet;
+  std::unique_ptr<Outlet> outlet;
   try {
-    outlet = std::make_unique<LcmOutlet>(url);
+    outlet = make_outlet(url);
   } catch (const std::exception& e) {
     log::critical("{}", e.what());
+    return 1;
+  }
+  const auto* udpm_outlet = dynamic_cast<const UdpmOutlet*>(outlet.get());
+  try {
+    add_inputs(pipeline, config, options, udpm_outlet != nullptr ? udpm_outlet->own_source() : std::nullopt);
+  } catch (const std::exception& e) {
+    log::critical("cannot open the sources: {}", e.what());
     return 1;
   }
   if (options.record) {

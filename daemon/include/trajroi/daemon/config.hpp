@@ -155,11 +155,13 @@ struct DaemonConfig {
 // udpm an IPv4 multicast address, a port 1 … 65535, ttl 0 … 255), else what is wrong with it.
 [[nodiscard]] std::string check_lcm_url(const std::string& url);
 
-// The multicast group and port of a udpm:// URL (LCM's defaults 239.255.76.67:7667 when the URL
-// names none); nullopt for the other providers. The URL must have passed check_lcm_url.
+// The multicast group, port and options of a udpm:// URL (LCM's defaults 239.255.76.67:7667
+// when the URL names none); nullopt for the other providers. The URL must have passed check_lcm_url.
 struct LcmGroup {
   std::string address;
   int port = 7667;
+  int ttl = 0;            // ?ttl= (liblcm's default: 0, this host only)
+  int recv_buf_size = 0;  // ?recv_buf_size= bytes (0: the kernel's default)
 };
 [[nodiscard]] std::optional<LcmGroup> lcm_multicast_group(const std::string& url);
 
