@@ -48,9 +48,9 @@ Publisher::Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, boo
       sweep_warn_limit_(pipeline.config.logging.warning_interval_s),
       trajectory_warn_limit_(pipeline.config.logging.warning_interval_s),
       late_limit_(pipeline.config.logging.warning_interval_s) {
-  // Here, before the loops start: the subscription first checks that this process's own
-  // multicast comes back (up to half a second when it does not), which must not hold up the
-  // publishing loop.
+  // Here, before the loops start: subscribing opens the receive socket (through liblcm, its
+  // self test can take seconds), which must not hold up the publishing loop. For udpm://, the
+  // outlet's start-up probe has already said whether this process's multicast comes back.
   const bool receiving = outlet_.subscribe(config_.lcm.trajectory,
                                            [this](std::span<const std::uint8_t> bytes, const std::string& channel) {
                                              on_trajectory_message(bytes, channel);

@@ -28,11 +28,12 @@ std::string errno_text() {
 bool drop_datagrams_from(int fd, const sockaddr_in& self) {
   std::array<sock_filter, 7> code{{
       BPF_STMT(BPF_LD | BPF_W | BPF_ABS, static_cast<std::uint32_t>(SKF_NET_OFF + 12)),  // IPv4 source
-      BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, ntohl(self.sin_addr.s_addr), 0, 3),
-      BPF_STMT(BPF_LDX | BPF_B | BPF_MSH, static_cast<std::uint32_t>(SKF_NET_OFF)),  // X = IPv4 header length
-      BPF_STMT(BPF_LD | BPF_H | BPF_IND, static_cast<std::uint32_t>(SKF_NET_OFF)),   // UDP source port
-      BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, ntohs(self.sin_port), 1, 0), BPF_STMT(BPF_RET | BPF_K, 0xFFFFFFFFu),  // keep
-      BPF_STMT(BPF_RET | BPF_K, 0),  // drop: this process's own
+      BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, ntohl(self.sin_addr.s_addr), 0, 3),            // else keep
+      BPF_STMT(BPF_LDX | BPF_B | BPF_MSH, static_cast<std::uint32_t>(SKF_NET_OFF)),      // IPv4 header length
+      BPF_STMT(BPF_LD | BPF_H | BPF_IND, static_cast<std::uint32_t>(SKF_NET_OFF)),       // UDP source port
+      BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, ntohs(self.sin_port), 1, 0),                   // then drop
+      BPF_STMT(BPF_RET | BPF_K, 0xFFFFFFFFu),                                            // keep, whole
+      BPF_STMT(BPF_RET | BPF_K, 0),                                                      // drop
   }};
   const sock_fprog program{static_cast<unsigned short>(code.size()), code.data()};
   return setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &program, sizeof program) == 0;
@@ -147,8 +148,8 @@ void UdpmReceiver::read(const OnMessage& on_message) {
     }
     const std::uint64_t sender = static_cast<std::uint64_t>(ntohl(from.sin_addr.s_addr)) << 16 | ntohs(from.sin_port);
     udpm::Reassembler::Message message;
-    const auto verdict =
-        reassembler_.accept(sender, std::span<const std::uint8_t>(buffer_.data(), static_cast<std::size_t>(got)), message);
+    const auto verdict = reassembler_.accept(
+        sender, std::span<const std::uint8_t>(buffer_.data(), static_cast<std::size_t>(got)), message);
     if (verdict == udpm::Reassembler::Verdict::kMessage) {
       on_message(message.channel, message.payload);
     } else if (verdict == udpm::Reassembler::Verdict::kMalformed && warn_limit_.allow(steady_ns(), suppressed)) {

@@ -226,3 +226,28 @@ TEST(LcmUdpm, MalformedDatagramsAreCountedNotDelivered) {
   EXPECT_EQ(r.counters().messages, 1u);
   EXPECT_EQ(r.counters().malformed, 14u);
 }
+
+TEST(LcmUdpm, PartialMessagesAreBoundedInNumberAndBytes) {
+  udpm::Reassembler r({"WANTED"});
+  udpm::Reassembler::Message m;
+  std::vector<udpm::Datagram> datagrams;
+  const std::string channel = "WANTED";
+  // 17 senders each begin a message: the first one begun goes.
+  const std::vector<std::uint8_t> payload = bytes_of(100000, 5);
+  ASSERT_TRUE(udpm::split_message(channel, payload, 1, datagrams));
+  for (std::uint64_t sender = 1; sender <= 17; ++sender)
+    ASSERT_EQ(r.accept(sender, wire(datagrams[0]), m), udpm::Reassembler::Verdict::kPending);
+  EXPECT_EQ(r.counters().abandoned, 1u);
+  EXPECT_EQ(r.accept(1, wire(datagrams[1]), m), udpm::Reassembler::Verdict::kOtherChannel);  // its start is gone
+  // A 10 MB message takes a 17th slot (one more small one goes); a second does not fit in
+  // 16 MiB beside it: the least recently fed go until it does, the small ones, then the first.
+  const std::vector<std::uint8_t> big = bytes_of(10u << 20, 6);
+  ASSERT_TRUE(udpm::split_message(channel, big, 2, datagrams));
+  ASSERT_EQ(r.accept(100, wire(datagrams[0]), m), udpm::Reassembler::Verdict::kPending);
+  ASSERT_EQ(r.accept(101, wire(datagrams[0]), m), udpm::Reassembler::Verdict::kPending);
+  EXPECT_EQ(r.counters().abandoned, 18u);  // 1 + 1 + the other 15 small ones + the first big one
+  for (std::size_t i = 1; i < datagrams.size(); ++i)
+    (void)r.accept(101, wire(datagrams[i]), m);
+  EXPECT_EQ(r.counters().messages, 1u);
+  EXPECT_TRUE(std::equal(m.payload.begin(), m.payload.end(), big.begin(), big.end()));
+}

@@ -6,7 +6,8 @@
 namespace trajroi::transport::udpm {
 namespace {
 
-constexpr std::size_t kMaxSenders = 16;  // partial messages held at once
+constexpr std::size_t kMaxSenders = 16;              // partial messages held at once
+constexpr std::size_t kMaxPartialBytes = 16u << 20;  // and their bytes (liblcm's MAX_FRAG_BUF_TOTAL_SIZE)
 
 void put_u32(std::uint8_t* p, std::uint32_t v) noexcept {
   p[0] = static_cast<std::uint8_t>(v >> 24);
@@ -99,12 +100,21 @@ Reassembler::Partial* Reassembler::find(std::uint64_t sender) noexcept {
   return nullptr;
 }
 
-Reassembler::Partial& Reassembler::make_room() {
-  if (partials_.size() < kMaxSenders) return partials_.emplace_back();  // reserved: no reallocation
-  // Every slot taken: the least recently fed partial message goes.
-  ++counters_.abandoned;
-  return *std::min_element(partials_.begin(), partials_.end(),
-                           [](const Partial& a, const Partial& b) { return a.last_use < b.last_use; });
+Reassembler::Partial& Reassembler::make_room(std::size_t bytes) {
+  // Bounded as liblcm bounds its fragment buffers: a few senders' messages, 16 MiB in all; the
+  // least recently fed partial messages go first.
+  const auto held = [this] {
+    std::size_t total = 0;
+    for (const Partial& p : partials_)
+      total += p.data.size();
+    return total;
+  };
+  while (!partials_.empty() && (partials_.size() == kMaxSenders || held() + bytes > kMaxPartialBytes)) {
+    ++counters_.abandoned;
+    partials_.erase(std::min_element(partials_.begin(), partials_.end(),
+                                     [](const Partial& a, const Partial& b) { return a.last_use < b.last_use; }));
+  }
+  return partials_.emplace_back();  // reserved: no reallocation
 }
 
 Reassembler::Verdict Reassembler::accept(std::uint64_t sender, std::span<const std::uint8_t> datagram, Message& out) {
@@ -147,7 +157,7 @@ Reassembler::Verdict Reassembler::accept(std::uint64_t sender, std::span<const s
     if (!wanted(channel, index)) return Verdict::kOtherChannel;
     if (size > max_message_bytes_ || body.size() > size) return malformed();
     if (partial == nullptr) {
-      partial = &make_room();
+      partial = &make_room(size);
       partial->sender = sender;
       partial->seqno = seqno;
       partial->fragments = fragments;

@@ -44,7 +44,8 @@ bool split_message(const std::string& channel, std::span<const std::uint8_t> pay
 
 // Messages from datagrams, for a set of channels (exact names): fragments of other channels'
 // messages are dropped at their first fragment, without storage. One partial message per
-// sender, as liblcm does: a sender's new message abandons its unfinished one (counted).
+// sender, as liblcm does: a sender's new message abandons its unfinished one (counted); at
+// most 16 partial messages and 16 MiB of them (the least recently fed go first, counted).
 class Reassembler {
  public:
   struct Message {
@@ -83,11 +84,11 @@ class Reassembler {
   };
   [[nodiscard]] bool wanted(std::string_view channel, std::size_t& index) const noexcept;
   Partial* find(std::uint64_t sender) noexcept;
-  Partial& make_room();
+  Partial& make_room(std::size_t bytes);
 
   std::vector<std::string> channels_;
   std::size_t max_message_bytes_;
-  std::vector<Partial> partials_;  // at most kMaxSenders
+  std::vector<Partial> partials_;  // reserved for all of them
   std::vector<std::uint8_t> whole_;
   std::uint64_t uses_ = 0;
   Counters counters_;
