@@ -9,6 +9,8 @@
 #include <limits>
 #include <numbers>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "trajroi/config/origin.hpp"
 #include "trajroi/config/text_file.hpp"
@@ -106,6 +108,21 @@ ThreadConfig read_thread(MapReader& parent, std::string_view key) {
   return t;
 }
 
+// The key=value options after '?' in a udpm:// URL's rest (after "udpm://"), in order.
+std::vector<std::pair<std::string, std::string>> udpm_options(const std::string& rest) {
+  std::vector<std::pair<std::string, std::string>> options;
+  const std::size_t question = rest.find('?');
+  std::size_t at = question == std::string::npos ? rest.size() : question + 1;
+  while (at < rest.size()) {
+    const std::size_t end = std::min(rest.find('&', at), rest.size());
+    const std::string option = rest.substr(at, end - at);
+    const std::size_t eq = option.find('=');
+    options.emplace_back(option.substr(0, eq), eq == std::string::npos ? "" : option.substr(eq + 1));
+    at = end + 1;
+  }
+  return options;
+}
+
 }  // namespace
 
 std::optional<LcmGroup> lcm_multicast_group(const std::string& url) {
@@ -117,18 +134,10 @@ std::optional<LcmGroup> lcm_multicast_group(const std::string& url) {
   group.address = target.substr(0, colon);
   if (group.address.empty()) group.address = "239.255.76.67";
   if (colon != std::string::npos) group.port = std::stoi(target.substr(colon + 1));
-  const std::size_t question = rest.find('?');
-  std::size_t at = question == std::string::npos ? rest.size() : question + 1;
-  while (at < rest.size()) {  // options as check_lcm_url accepts them; others are ignored here
-    const std::size_t end = std::min(rest.find('&', at), rest.size());
-    const std::string option = rest.substr(at, end - at);
-    const std::size_t eq = option.find('=');
-    const std::string value = eq == std::string::npos ? "" : option.substr(eq + 1);
-    const bool number =
-        !value.empty() && value.size() <= 9 && value.find_first_not_of("0123456789") == std::string::npos;
-    if (number && option.starts_with("ttl=")) group.ttl = std::stoi(value);
-    if (number && option.starts_with("recv_buf_size=")) group.recv_buf_size = std::stoi(value);
-    at = end + 1;
+  // Options as check_lcm_url accepts them (checked there); others are ignored here.
+  for (const auto& [key, value] : udpm_options(rest)) {
+    if (key == "ttl") group.ttl = std::stoi(value);
+    if (key == "recv_buf_size") group.recv_buf_size = std::stoi(value);
   }
   return group;
 }
@@ -143,7 +152,6 @@ std::string check_lcm_url(const std::string& url) {
   if (provider != "udpm") return {};
   const std::string rest = url.substr(scheme_end + 3);
   const std::string target = rest.substr(0, rest.find('?'));
-  const std::string options = rest.find('?') == std::string::npos ? "" : rest.substr(rest.find('?') + 1);
   const std::string address = target.substr(0, target.find(':'));
   if (!address.empty()) {
     in_addr parsed{};
@@ -160,13 +168,7 @@ std::string check_lcm_url(const std::string& url) {
     const std::string port_text = target.substr(target.find(':') + 1);
     if (!whole_number(port_text, 1, 65535)) return "port '" + port_text + "' is not a UDP port 1 … 65535";
   }
-  std::size_t at = 0;
-  while (at < options.size()) {
-    const std::size_t end = std::min(options.find('&', at), options.size());
-    const std::string option = options.substr(at, end - at);
-    const std::size_t eq = option.find('=');
-    const std::string key = option.substr(0, eq);
-    const std::string value = eq == std::string::npos ? "" : option.substr(eq + 1);
+  for (const auto& [key, value] : udpm_options(rest)) {
     if (key == "ttl") {
       if (!whole_number(value, 0, 255)) return "ttl '" + value + "' is not 0 … 255";
     } else if (key == "recv_buf_size") {
@@ -174,7 +176,6 @@ std::string check_lcm_url(const std::string& url) {
     } else {
       return "option '" + key + "' is not one of ttl, recv_buf_size";
     }
-    at = end + 1;
   }
   return {};
 }

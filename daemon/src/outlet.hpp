@@ -67,6 +67,7 @@ class UdpmOutlet final : public Outlet {
  private:
   std::string url_;
   LcmGroup group_;
+  sockaddr_in destination_;  // the group and its port
   int send_fd_ = -1;
   std::optional<sockaddr_in> own_source_;
   std::uint32_t seqno_ = 0;

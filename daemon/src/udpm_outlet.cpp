@@ -19,7 +19,8 @@ std::unique_ptr<Outlet> make_outlet(const std::string& url) {
   return std::make_unique<LcmOutlet>(url);
 }
 
-UdpmOutlet::UdpmOutlet(const std::string& url, const LcmGroup& group) : url_(url), group_(group) {
+UdpmOutlet::UdpmOutlet(const std::string& url, const LcmGroup& group)
+    : url_(url), group_(group), destination_(udpm_group_address(group, group.port)) {
   in_addr parsed{};
   if (inet_pton(AF_INET, group_.address.c_str(), &parsed) != 1)
     throw std::runtime_error("LCM: '" + url_ + "': '" + group_.address + "' is not an IPv4 address");
@@ -57,7 +58,6 @@ void UdpmOutlet::publish(const std::string& channel, std::span<const std::uint8_
   // All the message's datagrams in one system call (a cloud is several).
   std::array<mmsghdr, 64> headers{};
   std::array<std::array<iovec, 3>, 64> pieces{};
-  sockaddr_in to = udpm_group_address(group_, group_.port);
   std::size_t next = 0;
   while (next < datagrams_.size()) {
     const std::size_t count = std::min(headers.size(), datagrams_.size() - next);
@@ -67,8 +67,8 @@ void UdpmOutlet::publish(const std::string& channel, std::span<const std::uint8_
                    iovec{const_cast<std::uint8_t*>(d.channel.data()), d.channel.size()},
                    iovec{const_cast<std::uint8_t*>(d.payload.data()), d.payload.size()}};
       headers[i] = mmsghdr{};
-      headers[i].msg_hdr.msg_name = &to;
-      headers[i].msg_hdr.msg_namelen = sizeof to;
+      headers[i].msg_hdr.msg_name = &destination_;
+      headers[i].msg_hdr.msg_namelen = sizeof destination_;
       headers[i].msg_hdr.msg_iov = pieces[i].data();
       headers[i].msg_hdr.msg_iovlen = pieces[i].size();
     }
