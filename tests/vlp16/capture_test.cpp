@@ -3,9 +3,11 @@
 // data README's counts (made with a separate walker), MRPT's unit test, the GPRMC sentence,
 // and nebula's reference cloud.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -15,6 +17,7 @@
 #include <map>
 #include <numbers>
 #include <set>
+#include <thread>
 #include <tuple>
 
 #include "pcd_reader.hpp"
@@ -691,6 +694,52 @@ TEST(Vlp16Capture, EveryLinkTypeYieldsTheSameDatagram) {
   write_pcap(path, 105, {});  // IEEE 802.11
   EXPECT_THROW(PcapSource{path}, std::runtime_error);
   std::filesystem::remove(path);
+}
+
+// A regular file is mapped and read in place; a pipe (`--replay` from a FIFO, process
+// substitution) is read as a stream. Both give the same datagrams, times and ports, and an empty
+// file (nothing to map) is refused as libpcap refuses it.
+TEST(Vlp16Capture, AMappedFileAndAPipeGiveTheSameDatagrams) {
+  TRAJROI_REQUIRE_DATA(path, "velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap");
+  struct Seen {
+    std::vector<std::uint8_t> bytes;
+    std::vector<std::int64_t> times;
+    std::vector<std::uint16_t> ports;
+  };
+  const auto read_all = [](const std::filesystem::path& from) {
+    Seen seen;
+    PcapSource source(from);
+    Datagram datagram;
+    PacketSource::Next next;
+    while ((next = source.next(datagram)) == PacketSource::Next::kDatagram) {
+      seen.bytes.insert(seen.bytes.end(), datagram.payload.begin(), datagram.payload.end());
+      seen.times.push_back(datagram.receive_time_ns);
+      seen.ports.push_back(datagram.destination_port);
+    }
+    EXPECT_EQ(next, PacketSource::Next::kEnd) << from << ": " << source.error();
+    return seen;
+  };
+  const Seen mapped = read_all(path);
+  ASSERT_GT(mapped.times.size(), 100u);
+  const auto fifo = std::filesystem::path(testing::TempDir()) / "trajroi_capture.fifo";
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
+  std::thread writer([&] {
+    std::ofstream out(fifo, std::ios::binary);
+    const std::string bytes = test::read_file(path);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  });
+  const Seen streamed = read_all(fifo);
+  writer.join();
+  std::filesystem::remove(fifo);
+  EXPECT_EQ(streamed.times, mapped.times);
+  EXPECT_EQ(streamed.ports, mapped.ports);
+  EXPECT_TRUE(streamed.bytes == mapped.bytes);
+
+  const auto empty = std::filesystem::path(testing::TempDir()) / "trajroi_empty.pcap";
+  { std::ofstream out(empty, std::ios::binary); }
+  EXPECT_THROW(PcapSource{empty}, std::runtime_error);
+  std::filesystem::remove(empty);
 }
 
 TEST(Vlp16Capture, UnreadableFileIsAClearError) {

@@ -1,6 +1,10 @@
 #include "trajroi/vlp16/pcap_source.hpp"
 
+#include <fcntl.h>
 #include <pcap/pcap.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -61,20 +65,58 @@ long ipv4_offset(int link, const std::uint8_t* frame, std::size_t length) {
 struct PcapSource::Handle {
   pcap_t* pcap = nullptr;
   std::unique_ptr<char[]> buffer;  // the capture FILE's (glibc ignores a size without one)
+  void* mapping = MAP_FAILED;      // the whole capture, when it is a regular file
+  std::size_t mapping_bytes = 0;
   ~Handle() {
-    if (pcap != nullptr) pcap_close(pcap);  // closes the FILE, before the buffer goes
+    if (pcap != nullptr) pcap_close(pcap);  // closes the FILE, before the buffer or mapping goes
+    if (mapping != MAP_FAILED) (void)munmap(mapping, mapping_bytes);
   }
 };
 
+namespace {
+
+// A regular file's bytes, mapped and read through a memory FILE: libpcap's reads become copies
+// from the page cache's pages, without a read() system call copying every byte into a stdio
+// buffer first (on an AMD EPYC, Zen 3, the kernel's copy was 9 % of an as-fast replay's CPU).
+// Null when the file cannot be mapped (a pipe, an empty file): it is read as a stream then.
+std::FILE* open_mapped(int fd, void*& mapping, std::size_t& bytes) {
+  struct stat status {};
+  if (fstat(fd, &status) != 0 || !S_ISREG(status.st_mode) || status.st_size <= 0) return nullptr;
+  bytes = static_cast<std::size_t>(status.st_size);
+  mapping = mmap(nullptr, bytes, PROT_READ, MAP_PRIVATE, fd, 0);
+  if (mapping == MAP_FAILED) return nullptr;
+  (void)madvise(mapping, bytes, MADV_SEQUENTIAL);
+  std::FILE* file = fmemopen(mapping, bytes, "rb");
+  if (file == nullptr) {
+    (void)munmap(mapping, bytes);
+    mapping = MAP_FAILED;
+    return nullptr;
+  }
+  return file;
+}
+
+}  // namespace
+
 PcapSource::PcapSource(const std::filesystem::path& path, PcapOptions options)
     : handle_(std::make_unique<Handle>()), options_(std::move(options)) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
     const int error = errno;
     throw std::runtime_error(path.string() + ": cannot open capture: " + std::strerror(error));
   }
-  handle_->buffer = std::make_unique_for_overwrite<char[]>(kReadBufferBytes);
-  (void)std::setvbuf(file, handle_->buffer.get(), _IOFBF, kReadBufferBytes);  // the default buffer if refused
+  std::FILE* file = open_mapped(fd, handle_->mapping, handle_->mapping_bytes);
+  if (file != nullptr) {
+    (void)::close(fd);  // the mapping keeps the file
+  } else {
+    file = fdopen(fd, "rb");
+    if (file == nullptr) {
+      const int error = errno;
+      (void)::close(fd);
+      throw std::runtime_error(path.string() + ": cannot open capture: " + std::strerror(error));
+    }
+    handle_->buffer = std::make_unique_for_overwrite<char[]>(kReadBufferBytes);
+    (void)std::setvbuf(file, handle_->buffer.get(), _IOFBF, kReadBufferBytes);  // the default buffer if refused
+  }
   char message[PCAP_ERRBUF_SIZE] = {};
   handle_->pcap = pcap_fopen_offline_with_tstamp_precision(file, PCAP_TSTAMP_PRECISION_NANO, message);
   if (handle_->pcap == nullptr) {
