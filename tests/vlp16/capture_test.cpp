@@ -3,6 +3,7 @@
 // data README's counts (made with a separate walker), MRPT's unit test, the GPRMC sentence,
 // and nebula's reference cloud.
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -696,46 +697,144 @@ TEST(Vlp16Capture, EveryLinkTypeYieldsTheSameDatagram) {
   std::filesystem::remove(path);
 }
 
-// A regular file is mapped and read in place; a pipe (`--replay` from a FIFO, process
-// substitution) is read as a stream. Both give the same datagrams, times and ports, and an empty
-// file (nothing to map) is refused as libpcap refuses it.
-TEST(Vlp16Capture, AMappedFileAndAPipeGiveTheSameDatagrams) {
-  TRAJROI_REQUIRE_DATA(path, "velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap");
-  struct Seen {
-    std::vector<std::uint8_t> bytes;
-    std::vector<std::int64_t> times;
-    std::vector<std::uint16_t> ports;
-  };
-  const auto read_all = [](const std::filesystem::path& from) {
-    Seen seen;
-    PcapSource source(from);
-    Datagram datagram;
-    PacketSource::Next next;
-    while ((next = source.next(datagram)) == PacketSource::Next::kDatagram) {
-      seen.bytes.insert(seen.bytes.end(), datagram.payload.begin(), datagram.payload.end());
-      seen.times.push_back(datagram.receive_time_ns);
-      seen.ports.push_back(datagram.destination_port);
-    }
-    EXPECT_EQ(next, PacketSource::Next::kEnd) << from << ": " << source.error();
-    return seen;
-  };
-  const Seen mapped = read_all(path);
-  ASSERT_GT(mapped.times.size(), 100u);
+// What a capture gives, datagram by datagram, and how it ends.
+struct Seen {
+  std::vector<std::uint8_t> bytes;
+  std::vector<std::int64_t> times;
+  std::vector<std::uint16_t> ports;
+  PacketSource::Next end = PacketSource::Next::kDatagram;
+  std::uint64_t skipped = 0;
+  std::string error;
+};
+
+Seen read_capture(const std::filesystem::path& from) {
+  Seen seen;
+  PcapSource source(from);
+  Datagram datagram;
+  while ((seen.end = source.next(datagram)) == PacketSource::Next::kDatagram) {
+    seen.bytes.insert(seen.bytes.end(), datagram.payload.begin(), datagram.payload.end());
+    seen.times.push_back(datagram.receive_time_ns);
+    seen.ports.push_back(datagram.destination_port);
+  }
+  seen.skipped = source.skipped_records();
+  seen.error = source.error();
+  return seen;
+}
+
+// `bytes` as a regular file (mapped: a classic pcap file is read in place by trajroi) and
+// through a pipe (read as a stream by libpcap), which must agree datagram for datagram.
+void expect_read_in_place_as_libpcap_reads(const std::string& bytes, const std::string& what) {
+  const auto file = std::filesystem::path(testing::TempDir()) / "trajroi_capture.pcap";
   const auto fifo = std::filesystem::path(testing::TempDir()) / "trajroi_capture.fifo";
+  {
+    std::ofstream out(file, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  const Seen mapped = read_capture(file);
+  // A reader that stops at an error closes the pipe on a writer with bytes left: EPIPE, not
+  // the end of the test process.
+  struct sigaction ignore {};
+  struct sigaction before {};
+  ignore.sa_handler = SIG_IGN;
+  sigaction(SIGPIPE, &ignore, &before);
   std::filesystem::remove(fifo);
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
   std::thread writer([&] {
     std::ofstream out(fifo, std::ios::binary);
-    const std::string bytes = test::read_file(path);
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   });
-  const Seen streamed = read_all(fifo);
+  const Seen streamed = read_capture(fifo);
   writer.join();
+  sigaction(SIGPIPE, &before, nullptr);
   std::filesystem::remove(fifo);
-  EXPECT_EQ(streamed.times, mapped.times);
-  EXPECT_EQ(streamed.ports, mapped.ports);
-  EXPECT_TRUE(streamed.bytes == mapped.bytes);
+  std::filesystem::remove(file);
+  EXPECT_EQ(mapped.times.size(), streamed.times.size()) << what;
+  EXPECT_EQ(mapped.times, streamed.times) << what;
+  EXPECT_EQ(mapped.ports, streamed.ports) << what;
+  EXPECT_TRUE(mapped.bytes == streamed.bytes) << what;
+  EXPECT_EQ(mapped.end, streamed.end) << what << ": in place '" << mapped.error << "', libpcap '" << streamed.error
+                                      << "'";
+  EXPECT_EQ(mapped.skipped, streamed.skipped) << what;
+  if (streamed.error.find("truncated") != std::string::npos) {
+    EXPECT_NE(mapped.error.find("truncated"), std::string::npos) << what << ": " << mapped.error;
+  }
+}
 
+std::uint32_t get32(const std::string& b, std::size_t at) {
+  std::uint32_t v = 0;
+  std::memcpy(&v, b.data() + at, 4);
+  return v;
+}
+void put32(std::string& b, std::size_t at, std::uint32_t v) {
+  std::memcpy(b.data() + at, &v, 4);
+}
+void put16(std::string& b, std::size_t at, std::uint16_t v) {
+  std::memcpy(b.data() + at, &v, 2);
+}
+
+// Offsets of the record headers of a little-endian classic pcap file.
+std::vector<std::size_t> record_offsets(const std::string& b) {
+  std::vector<std::size_t> at;
+  for (std::size_t i = 24; i + 16 <= b.size(); i += 16 + get32(b, i + 8))
+    at.push_back(i);
+  return at;
+}
+
+// Every capture of the data folder, and variants of one made for the cases libpcap knows: time
+// stamps in ns, the other byte order, a snap length shorter than the records, a file cut in a
+// record header and in a record, a record longer than libpcap allows, and a file that is not a
+// capture.
+TEST(Vlp16Capture, ClassicCapturesAreReadInPlaceAsLibpcapReadsThem) {
+  TRAJROI_REQUIRE_DATA(mrpt, "velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap");
+  std::size_t files = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(test::data_dir() / "velodyne")) {
+    if (entry.path().extension() != ".pcap") continue;
+    expect_read_in_place_as_libpcap_reads(test::read_file(entry.path()), entry.path().filename().string());
+    ++files;
+  }
+  EXPECT_GE(files, 7u);
+
+  const std::string original = test::read_file(mrpt);
+  ASSERT_EQ(get32(original, 0), 0xA1B2C3D4u);  // little-endian, µs
+  const std::vector<std::size_t> records = record_offsets(original);
+  ASSERT_GT(records.size(), 200u);
+
+  std::string nanoseconds = original;
+  put32(nanoseconds, 0, 0xA1B23C4D);
+  expect_read_in_place_as_libpcap_reads(nanoseconds, "ns time stamps");
+
+  std::string big_endian = original;
+  const auto swap_field = [&big_endian](std::size_t at) {
+    put32(big_endian, at, __builtin_bswap32(get32(big_endian, at)));
+  };
+  for (std::size_t at : {0u, 8u, 12u, 16u, 20u})
+    swap_field(at);
+  put16(big_endian, 4, __builtin_bswap16(2));
+  put16(big_endian, 6, __builtin_bswap16(4));
+  for (std::size_t r : records) {
+    for (std::size_t field = 0; field < 16; field += 4)
+      swap_field(r + field);
+  }
+  expect_read_in_place_as_libpcap_reads(big_endian, "big-endian");
+
+  std::string short_snap = original;
+  put32(short_snap, 16, 600);  // shorter than a data packet's frame: those are cut and skipped
+  expect_read_in_place_as_libpcap_reads(short_snap, "snap length 600");
+
+  expect_read_in_place_as_libpcap_reads(original.substr(0, records[150] + 9), "cut in a record header");
+  expect_read_in_place_as_libpcap_reads(original.substr(0, records[150] + 16 + 700), "cut in a record");
+
+  std::string oversized = original;
+  put32(oversized, records[40] + 8, 300'000);
+  expect_read_in_place_as_libpcap_reads(oversized, "a record over 262 144 bytes");
+
+  const auto not_capture = std::filesystem::path(testing::TempDir()) / "trajroi_not_capture.pcap";
+  {
+    std::ofstream out(not_capture, std::ios::binary);
+    out << "this is not a capture file, only text long enough to have a header";
+  }
+  EXPECT_THROW(PcapSource{not_capture}, std::runtime_error);
+  std::filesystem::remove(not_capture);
   const auto empty = std::filesystem::path(testing::TempDir()) / "trajroi_empty.pcap";
   { std::ofstream out(empty, std::ios::binary); }
   EXPECT_THROW(PcapSource{empty}, std::runtime_error);

@@ -41,6 +41,8 @@ class PcapSource final : public PacketSource {
 
  private:
   Next read(Datagram& datagram);
+  // The next record's frame, its captured length and time stamp (ns).
+  Next next_record(const std::uint8_t*& frame, std::size_t& length, std::int64_t& time_ns);
 
   struct Handle;
   std::unique_ptr<Handle> handle_;
