@@ -99,11 +99,13 @@ ScanCalibration GridFilter<RoiSet>::calibrate() const {
   cloud.reserve(kFirings * kLasers);
   for (std::size_t f = 0; f < kFirings; ++f) {
     const double azimuth = 2.0 * std::numbers::pi * static_cast<double>(f) / static_cast<double>(kFirings);
+    const double cos_a = std::cos(azimuth);  // once per firing: start-up is part of a replay's time
+    const double sin_a = std::sin(azimuth);
     for (std::size_t l = 0; l < kLasers; ++l) {
       const double ring = reach * static_cast<double>(l + 1) / static_cast<double>(kLasers);
       const double r = ring * (1.0 + 0.05 * std::sin(7.0 * azimuth + static_cast<double>(l)));
-      cloud.push_back({static_cast<float>(cx + r * std::cos(azimuth)), static_cast<float>(cy + r * std::sin(azimuth)),
-                       static_cast<float>(z), 0.0f});
+      cloud.push_back(
+          {static_cast<float>(cx + r * cos_a), static_cast<float>(cy + r * sin_a), static_cast<float>(z), 0.0f});
     }
   }
   IndexVector kept;
