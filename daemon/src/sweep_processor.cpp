@@ -230,10 +230,14 @@ SweepProcessor::SweepProcessor(const DaemonConfig& config, std::unique_ptr<Activ
   scratch_.resize(kScratchPoints);  // used as [0, batch): never resized (value-initialising) after
   kept_.reserve(kScratchPoints);
   roi::place_centres(active_->trajectory, 0.0, longest, r.spacing_ratio * size_along(r), sweep_.centres);
-  circles_.assign(sweep_.centres);
-  rects_.assign(sweep_.centres);
-  circle_grid_.build(circles_);
-  rect_grid_.build(rects_);
+  // The configured shape's only: the other is never used (start-up is part of a replay's time).
+  if (config_.roi.shape == RoiShape::kCircular) {
+    circles_.assign(sweep_.centres);
+    circle_grid_.build(circles_);
+  } else {
+    rects_.assign(sweep_.centres);
+    rect_grid_.build(rects_);
+  }
   sweep_.centres.clear();
 }
 
