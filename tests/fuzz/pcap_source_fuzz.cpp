@@ -1,5 +1,6 @@
-// The pcap reader: the input as a capture file (libpcap's own parsing, then ours of the link,
-// IP and UDP headers, fragments and ports).
+// The pcap reader: the input as a capture file (a memfd: mapped, so a classic pcap file goes
+// through trajroi's own record parsing and anything else through libpcap's), then ours of the
+// link, IP and UDP headers, fragments and ports.
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -23,7 +24,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (int k = 0; k < 100'000 && source.next(datagram) == trajroi::vlp16::PacketSource::Next::kDatagram; ++k) {
     }
   } catch (const std::exception&) {
-    // Not a capture libpcap can open: the documented error.
+    // Not a capture that can be opened: the documented error.
   }
   close(fd);
   return 0;

@@ -841,6 +841,38 @@ TEST(Vlp16Capture, ClassicCapturesAreReadInPlaceAsLibpcapReadsThem) {
   std::filesystem::remove(empty);
 }
 
+// A capture another program truncates while it is replayed (its pages past the new end gone
+// from the mapping): a read error that says so, not a SIGBUS that ends the process; the thread
+// stays able to do it again, and a capture read afterwards reads as before.
+TEST(Vlp16Capture, ACaptureTruncatedWhileItIsReadIsAReadErrorNotACrash) {
+  TRAJROI_REQUIRE_DATA(path, "velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap");
+  const std::string bytes = test::read_file(path);
+  ASSERT_GT(bytes.size(), 64u * 1024u);
+  const auto copy = std::filesystem::path(testing::TempDir()) / "trajroi_shrinking.pcap";
+  for (int round = 0; round < 2; ++round) {
+    {
+      std::ofstream out(copy, std::ios::binary | std::ios::trunc);
+      out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    }
+    PcapSource source(copy);
+    Datagram datagram;
+    for (int k = 0; k < 5; ++k)
+      ASSERT_EQ(source.next(datagram), PacketSource::Next::kDatagram) << source.error();
+    std::filesystem::resize_file(copy, 16 * 1024);  // a page boundary past what was read
+    std::size_t more = 0;
+    PacketSource::Next next;
+    while ((next = source.next(datagram)) == PacketSource::Next::kDatagram)
+      ++more;
+    EXPECT_EQ(next, PacketSource::Next::kError) << "round " << round;
+    EXPECT_NE(source.error().find("shrank"), std::string::npos) << source.error();
+    EXPECT_LT(more, 20u);
+  }
+  std::filesystem::remove(copy);
+  const Seen after = read_capture(path);
+  EXPECT_EQ(after.end, PacketSource::Next::kEnd) << after.error;
+  EXPECT_GT(after.times.size(), 100u);
+}
+
 TEST(Vlp16Capture, UnreadableFileIsAClearError) {
   try {
     PcapSource source("/nonexistent/capture.pcap");

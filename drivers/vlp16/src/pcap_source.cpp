@@ -2,6 +2,8 @@
 
 #include <fcntl.h>
 #include <pcap/pcap.h>
+#include <setjmp.h>
+#include <signal.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -12,6 +14,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <utility>
+#include <vector>
 
 namespace trajroi::vlp16 {
 namespace {
@@ -62,14 +65,47 @@ long ipv4_offset(int link, const std::uint8_t* frame, std::size_t length) {
 
 }  // namespace
 
-// A classic pcap file (not pcapng), mapped: its records are read where they lie, without a
-// copy. The rules are libpcap's (savefile.c, sf-pcap.c): a file header of 24 bytes, then records
+// A mapped file that another process truncates while it is read: a read of a page past its new
+// end raises SIGBUS, which would end the daemon. The records are copied out of the mapping under
+// this guard: a SIGBUS in a guarded copy of this thread jumps back to it, which reports a read
+// error; any other SIGBUS takes the action it had before (the handler puts it back and the
+// faulting instruction runs again).
+namespace {
+namespace bus_guard {
+
+thread_local sigjmp_buf* active = nullptr;
+struct sigaction previous {};
+
+void on_sigbus(int signal, siginfo_t* info, void* context) {
+  (void)info;
+  (void)context;
+  if (active != nullptr) siglongjmp(*active, 1);
+  (void)sigaction(signal, &previous, nullptr);
+}
+
+void install() {
+  static const bool installed = [] {
+    struct sigaction action {};
+    action.sa_sigaction = on_sigbus;
+    action.sa_flags = SA_SIGINFO | SA_NODEFER;  // SIGBUS not blocked after the jump out
+    sigemptyset(&action.sa_mask);
+    return sigaction(SIGBUS, &action, &previous) == 0;
+  }();
+  (void)installed;
+}
+
+}  // namespace bus_guard
+}  // namespace
+
+// A classic pcap file (not pcapng), mapped: its records are read without a read() system call
+// or libpcap's copies. The rules are libpcap's (savefile.c, sf-pcap.c): a file header of 24 bytes, then records
 // of a 16-byte header and the captured bytes; a record cut by the end of the file is an error; a
 // captured length over 262 144 bytes is an error; one over the file's snap length is cut to it.
 struct ClassicPcap {
   const std::uint8_t* data = nullptr;
   std::size_t size = 0;
   std::size_t at = 24;        // the next record
+  std::size_t released = 0;   // the mapping's pages before this are given back
   bool swapped = false;       // written on a machine of the other byte order
   bool nanoseconds = false;   // time stamps in ns (magic 0xA1B23C4D), else µs
   std::uint32_t snaplen = 0;  // of the file, as libpcap adjusts it
@@ -88,6 +124,19 @@ struct ClassicPcap {
     std::uint16_t v = 0;
     std::memcpy(&v, data + offset, sizeof v);
     return swapped ? __builtin_bswap16(v) : v;
+  }
+
+  // Every 4 MiB read, the pages behind are unmapped (the page cache keeps them): read pages of a
+  // mapped file count in the process's RSS, which grew by the capture's size in each lap of a
+  // looped replay (the soak's RSS check failed at +26 %).
+  void release_behind() noexcept {
+    constexpr std::size_t kStep = std::size_t{4} << 20;
+    if (at - released < kStep) return;
+    static const auto page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+    const std::size_t until = at / page * page;
+    // The mapping starts on a page; `data` is const only to the parser.
+    (void)madvise(const_cast<std::uint8_t*>(data) + released, until - released, MADV_DONTNEED);
+    released = until;
   }
 
   // Reads the file header; false for anything but a classic pcap file of version 2.4 (libpcap
@@ -122,8 +171,25 @@ struct ClassicPcap {
     return true;
   }
 
-  PcapSource::Next next(const std::uint8_t*& frame, std::size_t& length, std::int64_t& time_ns,
+  // The next record's frame, copied into `frame_copy` (the mapping may not be read outside the
+  // guard).
+  PcapSource::Next next(std::vector<std::uint8_t>& frame_copy, std::size_t& length, std::int64_t& time_ns,
                         std::string& error) noexcept {
+    sigjmp_buf jump;
+    if (sigsetjmp(jump, 0) != 0) {
+      bus_guard::active = nullptr;
+      error = "the capture file shrank while it was read (truncated by another program?): read error at byte " +
+              std::to_string(at);
+      return PcapSource::Next::kError;
+    }
+    bus_guard::active = &jump;
+    const PcapSource::Next got = next_unguarded(frame_copy, length, time_ns, error);
+    bus_guard::active = nullptr;
+    return got;
+  }
+
+  PcapSource::Next next_unguarded(std::vector<std::uint8_t>& frame_copy, std::size_t& length, std::int64_t& time_ns,
+                                  std::string& error) noexcept {
     const std::size_t left = size - at;
     if (left == 0) return PcapSource::Next::kEnd;
     if (left < kRecordHeader) {
@@ -144,11 +210,12 @@ struct ClassicPcap {
               std::to_string(left - kRecordHeader);
       return PcapSource::Next::kError;
     }
-    frame = data + at + kRecordHeader;
     length = std::min(captured, snaplen);  // the rest of a record longer than the snap length is skipped
+    std::memcpy(frame_copy.data(), data + at + kRecordHeader, length);  // sized for kMaxSnaplen
     time_ns = static_cast<std::int64_t>(seconds) * 1'000'000'000 +
               static_cast<std::int64_t>(fraction) * (nanoseconds ? 1 : 1'000);
     at += kRecordHeader + captured;
+    release_behind();
     return PcapSource::Next::kDatagram;
   }
 };
@@ -160,6 +227,7 @@ struct PcapSource::Handle {
   std::size_t mapping_bytes = 0;
   bool in_place = false;  // a classic pcap file, mapped: read by `classic`, not by libpcap
   ClassicPcap classic;
+  std::vector<std::uint8_t> frame;  // the last record's, copied out of the mapping
   ~Handle() {
     if (pcap != nullptr) pcap_close(pcap);  // closes the FILE, before the buffer or mapping goes
     if (mapping != MAP_FAILED) (void)munmap(mapping, mapping_bytes);
@@ -168,17 +236,32 @@ struct PcapSource::Handle {
 
 namespace {
 
-// A regular file's bytes, mapped: read in place when they are a classic pcap file (the usual
-// capture, and the one trajroid records), else through a memory FILE by libpcap (pcapng). Either
-// way no read() system call copies every byte into a stdio buffer first: on an AMD EPYC (Zen 3)
-// the kernel's copy was 9 % of an as-fast replay's CPU, and libpcap's copies 3 % more. False
-// when the file cannot be mapped (a pipe, an empty file): it is read as a stream then.
-bool map_capture(int fd, void*& mapping, std::size_t& bytes) {
+// A regular file's bytes, mapped, when they are a classic pcap file (the usual capture, and the
+// one trajroid records): no read() system call copies every byte into a stdio buffer first, nor
+// libpcap from there into its own (on an AMD EPYC, Zen 3, the kernel's copy alone was 9 % of an
+// as-fast replay's CPU). Anything else (pcapng, a pipe, an empty file) is read by libpcap as a
+// stream.
+bool map_classic_capture(int fd, void*& mapping, std::size_t& bytes, ClassicPcap& classic) {
   struct stat status {};
   if (fstat(fd, &status) != 0 || !S_ISREG(status.st_mode) || status.st_size <= 0) return false;
   bytes = static_cast<std::size_t>(status.st_size);
   mapping = mmap(nullptr, bytes, PROT_READ, MAP_PRIVATE, fd, 0);
   if (mapping == MAP_FAILED) return false;
+  bus_guard::install();
+  bool classic_file = false;
+  {
+    sigjmp_buf jump;
+    if (sigsetjmp(jump, 0) == 0) {
+      bus_guard::active = &jump;
+      classic_file = classic.open(static_cast<const std::uint8_t*>(mapping), bytes);
+    }
+    bus_guard::active = nullptr;
+  }
+  if (!classic_file) {
+    (void)munmap(mapping, bytes);
+    mapping = MAP_FAILED;
+    return false;
+  }
   (void)madvise(mapping, bytes, MADV_SEQUENTIAL);
   return true;
 }
@@ -192,20 +275,13 @@ PcapSource::PcapSource(const std::filesystem::path& path, PcapOptions options)
     const int error = errno;
     throw std::runtime_error(path.string() + ": cannot open capture: " + std::strerror(error));
   }
-  std::FILE* file = nullptr;
-  if (map_capture(fd, handle_->mapping, handle_->mapping_bytes)) {
+  handle_->in_place = map_classic_capture(fd, handle_->mapping, handle_->mapping_bytes, handle_->classic);
+  if (handle_->in_place) {
     (void)::close(fd);  // the mapping keeps the file
-    handle_->in_place =
-        handle_->classic.open(static_cast<const std::uint8_t*>(handle_->mapping), handle_->mapping_bytes);
-    if (!handle_->in_place) {
-      file = fmemopen(handle_->mapping, handle_->mapping_bytes, "rb");
-      if (file == nullptr) {
-        const int error = errno;
-        throw std::runtime_error(path.string() + ": cannot open capture: " + std::strerror(error));
-      }
-    }
+    handle_->frame.resize(ClassicPcap::kMaxSnaplen);
+    link_type_ = handle_->classic.link_type;
   } else {
-    file = fdopen(fd, "rb");
+    std::FILE* file = fdopen(fd, "rb");
     if (file == nullptr) {
       const int error = errno;
       (void)::close(fd);
@@ -213,10 +289,6 @@ PcapSource::PcapSource(const std::filesystem::path& path, PcapOptions options)
     }
     handle_->buffer = std::make_unique_for_overwrite<char[]>(kReadBufferBytes);
     (void)std::setvbuf(file, handle_->buffer.get(), _IOFBF, kReadBufferBytes);  // the default buffer if refused
-  }
-  if (handle_->in_place) {
-    link_type_ = handle_->classic.link_type;
-  } else {
     char message[PCAP_ERRBUF_SIZE] = {};
     handle_->pcap = pcap_fopen_offline_with_tstamp_precision(file, PCAP_TSTAMP_PRECISION_NANO, message);
     if (handle_->pcap == nullptr) {
@@ -239,7 +311,10 @@ PcapSource::Next PcapSource::next(Datagram& datagram, std::chrono::milliseconds 
 }
 
 PcapSource::Next PcapSource::next_record(const std::uint8_t*& frame, std::size_t& length, std::int64_t& time_ns) {
-  if (handle_->in_place) return handle_->classic.next(frame, length, time_ns, error_);
+  if (handle_->in_place) {
+    frame = handle_->frame.data();
+    return handle_->classic.next(handle_->frame, length, time_ns, error_);
+  }
   pcap_pkthdr* header = nullptr;
   const int status = pcap_next_ex(handle_->pcap, &header, &frame);
   if (status == PCAP_ERROR_BREAK) return Next::kEnd;
