@@ -98,9 +98,10 @@ void install() {
 }  // namespace
 
 // A classic pcap file (not pcapng), mapped: its records are read without a read() system call
-// or libpcap's copies. The rules are libpcap's (savefile.c, sf-pcap.c): a file header of 24 bytes, then records
-// of a 16-byte header and the captured bytes; a record cut by the end of the file is an error; a
-// captured length over 262 144 bytes is an error; one over the file's snap length is cut to it.
+// or libpcap's copies. The rules are libpcap's (savefile.c, sf-pcap.c): a file header of 24
+// bytes, then records of a 16-byte header and the captured bytes; a record cut by the end of the
+// file is an error; a captured length over 262 144 bytes is an error; one over the file's snap
+// length is cut to it.
 struct ClassicPcap {
   const std::uint8_t* data = nullptr;
   std::size_t size = 0;
@@ -223,7 +224,7 @@ struct ClassicPcap {
 struct PcapSource::Handle {
   pcap_t* pcap = nullptr;
   std::unique_ptr<char[]> buffer;  // the capture FILE's (glibc ignores a size without one)
-  void* mapping = MAP_FAILED;      // the whole capture, when it is a regular file
+  void* mapping = MAP_FAILED;      // the whole capture, when it is a classic pcap file
   std::size_t mapping_bytes = 0;
   bool in_place = false;  // a classic pcap file, mapped: read by `classic`, not by libpcap
   ClassicPcap classic;
@@ -248,7 +249,7 @@ bool map_classic_capture(int fd, void*& mapping, std::size_t& bytes, ClassicPcap
   mapping = mmap(nullptr, bytes, PROT_READ, MAP_PRIVATE, fd, 0);
   if (mapping == MAP_FAILED) return false;
   bus_guard::install();
-  bool classic_file = false;
+  volatile bool classic_file = false;  // kept across a jump back from the guard
   {
     sigjmp_buf jump;
     if (sigsetjmp(jump, 0) == 0) {
