@@ -3,7 +3,14 @@
 // the sweep is decoded from the same capture, each point placed with the true pose, and the
 // ground truth is the corridor matched to the sweep's published ROI chain (as the keyframe
 // evaluation does). Ends at the daemon's final status (or after --seconds).
+//
+// Scoring a sweep takes longer than hearing it (tens of ms; far more in a sanitizer build), and
+// the LCM socket's buffer holds only a few sweeps: the scoring runs on its own thread, fed by a
+// queue, so that the receiving loop never falls behind and loses sweeps (it did, hearing 195 of
+// 266, under ASan on a loaded 2-core machine).
+#include <algorithm>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <deque>
 #include <lcm/lcm-cpp.hpp>
@@ -12,7 +19,8 @@
 #include <mutex>
 #include <optional>
 #include <string>
-#include <tuple>
+#include <thread>
+#include <utility>
 
 #include "commands.hpp"
 #include "trajroi/eval/scenario_eval.hpp"
@@ -61,16 +69,23 @@ class TruthScorer {
     // A point is known by its time after the sweep's start (the sensor's clock: the same in the
     // capture and in the daemon, replayed or live), ring and return. Absolute times differ live:
     // the daemon anchors the sensor's clock to its own receive times, the capture to the
-    // recorded ones.
-    std::map<std::tuple<std::int64_t, int, int>, std::size_t> index;
+    // recorded ones. The keys are sorted with the point's index, so that a repeated key finds
+    // its last point.
+    index_.clear();
     for (std::size_t i = 0; i < frame->points.size(); ++i) {
       const auto& p = frame->points[i];
-      index[{p.time_offset_ns, p.ring, static_cast<int>(p.return_type)}] = i;
+      index_.emplace_back(point_key(p.time_offset_ns, p.ring, static_cast<std::uint8_t>(p.return_type)),
+                          static_cast<std::uint32_t>(i));
     }
+    std::sort(index_.begin(), index_.end());
     roi::IndexVector kept;
     for (std::size_t k = 0; k < m.x.size(); ++k) {
-      const auto it = index.find({m.time_offset_ns[k], m.ring[k], m.return_type[k]});
-      if (it != index.end()) kept.push_back(static_cast<std::uint32_t>(it->second));
+      if (m.time_offset_ns[k] < 0) continue;  // never a capture point's
+      const std::uint64_t key =
+          point_key(static_cast<std::uint32_t>(m.time_offset_ns[k]), static_cast<std::uint8_t>(m.ring[k]),
+                    static_cast<std::uint8_t>(m.return_type[k]));
+      const auto after = std::upper_bound(index_.begin(), index_.end(), std::pair{key, ~std::uint32_t{0}});
+      if (after != index_.begin() && std::prev(after)->first == key) kept.push_back(std::prev(after)->second);
     }
     std::sort(kept.begin(), kept.end());
     std::vector<std::uint8_t> truth(truth_points_.size());
@@ -87,6 +102,10 @@ class TruthScorer {
   [[nodiscard]] std::size_t scored() const noexcept { return scored_; }
 
  private:
+  static std::uint64_t point_key(std::uint32_t time_offset_ns, std::uint8_t ring, std::uint8_t return_type) noexcept {
+    return (std::uint64_t{time_offset_ns} << 16) | (std::uint64_t{ring} << 8) | return_type;
+  }
+
   const vlp16::Frame* frame_at(std::uint64_t index) {
     struct Keep final : vlp16::FrameSink {
       std::deque<vlp16::Frame>* frames;
@@ -111,15 +130,74 @@ class TruthScorer {
   std::deque<vlp16::Frame> frames_;
   bool ended_ = false;
   std::vector<roi::PointXYZd> truth_points_;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> index_;
   roi::Confusion total_{};
   std::size_t scored_ = 0;
+};
+
+// Sweeps heard wait here for the scoring thread. At most kMaxWaiting wait (about a minute of
+// sweeps, some 400 MB): a scorer further behind than that has the newer sweeps counted as not
+// scored, never the receiving loop held up.
+class ScoringThread {
+ public:
+  static constexpr std::size_t kMaxWaiting = 600;
+
+  explicit ScoringThread(TruthScorer& scorer) : scorer_(scorer), thread_([this] { run(); }) {}
+  ScoringThread(const ScoringThread&) = delete;
+  ScoringThread& operator=(const ScoringThread&) = delete;
+  ~ScoringThread() { finish(); }
+
+  // False when kMaxWaiting sweeps already wait.
+  bool offer(const trajroi::points_t& points, const trajroi::roi_t& roi) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (waiting_.size() >= kMaxWaiting) return false;
+      waiting_.emplace_back(points, roi);
+    }
+    wake_.notify_one();
+    return true;
+  }
+
+  // Scores every sweep still waiting, then ends the thread.
+  void finish() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      finishing_ = true;
+    }
+    wake_.notify_one();
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  void run() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      wake_.wait(lock, [this] { return finishing_ || !waiting_.empty(); });
+      if (waiting_.empty()) return;
+      const std::pair<trajroi::points_t, trajroi::roi_t> sweep = std::move(waiting_.front());
+      waiting_.pop_front();
+      lock.unlock();
+      scorer_.score(sweep.first, sweep.second);
+      lock.lock();
+    }
+  }
+
+  TruthScorer& scorer_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::pair<trajroi::points_t, trajroi::roi_t>> waiting_;
+  bool finishing_ = false;
+  std::thread thread_;  // last: started once the members above exist
 };
 
 class Watcher {
  public:
   explicit Watcher(const WatchOptions& o) : o_(o), lcm_(o.url) {
     if (!lcm_.good()) throw std::runtime_error("LCM: cannot open '" + o.url + "'");
-    if (!o.run_dir.empty()) scorer_ = std::make_unique<TruthScorer>(o.run_dir);
+    if (!o.run_dir.empty()) {
+      scorer_ = std::make_unique<TruthScorer>(o.run_dir);
+      scoring_ = std::make_unique<ScoringThread>(*scorer_);
+    }
     trajroi::transport::subscribe<&Watcher::on_points>(lcm_, o.prefix + "_POINTS", this);
     trajroi::transport::subscribe<&Watcher::on_roi>(lcm_, o.prefix + "_ROI", this);
     trajroi::transport::subscribe<&Watcher::on_status>(lcm_, o.prefix + "_STATUS", this);
@@ -145,6 +223,11 @@ class Watcher {
           s.latency_ms_p99, static_cast<long long>(s.ring_drops));
     }
     std::printf("\n");
+    if (scoring_) scoring_->finish();
+    if (not_scored_ > 0) {
+      std::printf("trajroi watch: %zu sweeps heard but not scored: the scorer was %zu sweeps behind\n", not_scored_,
+                  ScoringThread::kMaxWaiting);
+    }
     if (scorer_ && scorer_->scored() > 0) {
       const roi::Confusion& c = scorer_->total();
       std::printf(
@@ -160,7 +243,7 @@ class Watcher {
   void on_points(const lcm::ReceiveBuffer*, const std::string&, const trajroi::points_t* m) {
     ++points_heard_;
     const auto roi = rois_.find(m->sweep_index);
-    if (scorer_ && roi != rois_.end()) scorer_->score(*m, roi->second);
+    if (scoring_ && roi != rois_.end() && !scoring_->offer(*m, roi->second)) ++not_scored_;
     rois_.erase(rois_.begin(), rois_.upper_bound(m->sweep_index));
   }
   void on_roi(const lcm::ReceiveBuffer*, const std::string&, const trajroi::roi_t* m) { rois_[m->sweep_index] = *m; }
@@ -180,9 +263,11 @@ class Watcher {
   WatchOptions o_;
   lcm::LCM lcm_;
   std::unique_ptr<TruthScorer> scorer_;
+  std::unique_ptr<ScoringThread> scoring_;  // after scorer_: it ends first
   std::map<std::int64_t, trajroi::roi_t> rois_;
   std::optional<trajroi::status_t> last_;
   std::size_t points_heard_ = 0;
+  std::size_t not_scored_ = 0;
   bool done_ = false;
 };
 
