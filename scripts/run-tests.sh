@@ -10,9 +10,9 @@
 #      fuzz, scripts/fuzz.sh), which fails on any crash, leak or timeout.
 #   TRAJROI_SKIP_SANITIZERS=1  runs the release suite only (quicker local runs).
 # The sanitizer builds use clang: on 2 cores GCC took 29 minutes to build the ASan tree alone,
-# clang takes 12, and the TSan tests ran 2–3 times as long under GCC's TSan as under clang's; the clang release tree (preset
-# clang) is no longer built separately, since the asan tree compiles every target with clang
-# and -Werror.
+# clang takes 12, and the TSan tests ran 2–3 times as long under GCC's TSan as under clang's.
+# The clang release tree (preset clang) is no longer built here: the asan tree compiles every
+# target with clang and -Werror.
 # Each stage prints its wall time.
 set -euo pipefail
 cd "$(dirname "$0")/.."

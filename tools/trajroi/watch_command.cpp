@@ -135,9 +135,9 @@ class TruthScorer {
   std::size_t scored_ = 0;
 };
 
-// Sweeps heard wait here for the scoring thread. At most kMaxWaiting wait (about a minute of
-// sweeps, some 400 MB): a scorer further behind than that has the newer sweeps counted as not
-// scored, never the receiving loop held up.
+// Sweeps heard wait here for the scoring thread. At most kMaxWaiting wait (a minute of sweeps at
+// 10 Hz, a few hundred MB): a scorer further behind than that has the newer sweeps counted as
+// not scored, never the receiving loop held up.
 class ScoringThread {
  public:
   static constexpr std::size_t kMaxWaiting = 600;
