@@ -490,10 +490,14 @@ pose::PoseStatus SweepProcessor::filter_batch(const vlp16::Frame& frame, std::si
   std::uint8_t* const ring = grown(s.ring);
   std::uint8_t* const return_type = grown(s.return_type);
   std::int32_t* const time_offset_ns = grown(s.time_offset_ns);
+  // The sources in locals too: every byte stored may alias anything, so the compiler would
+  // reload the vectors' data pointers after each one.
   const std::uint32_t* const kept = kept_.data();
+  const roi::PointXYZI* const placed_at = scratch_.data();
+  const vlp16::Point* const batch = frame.points.data() + first;
   for (std::size_t k = 0; k < n; ++k) {
-    const roi::PointXYZI& g = scratch_[kept[k]];
-    const vlp16::Point& p = frame.points[first + kept[k]];
+    const roi::PointXYZI& g = placed_at[kept[k]];
+    const vlp16::Point& p = batch[kept[k]];
     x[k] = g.x;
     y[k] = g.y;
     z[k] = g.z;

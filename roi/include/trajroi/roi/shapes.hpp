@@ -209,12 +209,15 @@ inline SlabRange slab_range(double ox, double oy, double ex, double ey, const Bo
 }  // namespace detail
 
 inline CellRelation CircularRoiSet::relation(std::size_t j, const Box& cell, double tolerance_m) const noexcept {
-  if (std::sqrt(detail::box_far_distance2(cell, cx_[j], cy_[j])) <= radius_m_ - tolerance_m) {
+  // Compared as squares (no square roots: the grid's build made up to two per cell and ROI).
+  // The squares' rounding (a few ulps of r²) is far inside the margin, which is what keeps a
+  // decision from contradicting the per-point test's.
+  const double inner = radius_m_ - tolerance_m;
+  if (inner >= 0.0 && detail::box_far_distance2(cell, cx_[j], cy_[j]) <= inner * inner) {
     return CellRelation::kInside;
   }
-  if (std::sqrt(detail::box_distance2(cell, cx_[j], cy_[j])) > radius_m_ + tolerance_m) {
-    return CellRelation::kOutside;
-  }
+  const double outer = radius_m_ + tolerance_m;
+  if (detail::box_distance2(cell, cx_[j], cy_[j]) > outer * outer) return CellRelation::kOutside;
   return CellRelation::kBoundary;
 }
 
