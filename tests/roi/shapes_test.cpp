@@ -96,5 +96,14 @@ TEST(CellRelation, IsConservative) {
   EXPECT_EQ(circles.relation(0, Box{0, 0, 3, 0}, 1e-9), CellRelation::kBoundary);
 }
 
+// The relation compares squared distances: a radius below the margin leaves r − tol negative,
+// whose square would be positive and call a tiny cell at the centre inside. No cell is.
+TEST(CellRelation, ARadiusBelowTheMarginHasNoInsideCell) {
+  const std::vector<Centre> centres{{V(0, 0), 0.0, 0.0}};
+  const CircularRoiSet tiny(1e-10, centres);
+  EXPECT_EQ(tiny.relation(0, Box{0, 0, 1e-12, 1e-12}, 1e-9), CellRelation::kBoundary);
+  EXPECT_EQ(tiny.relation(0, Box{1.0, 1.0, 2.0, 2.0}, 1e-9), CellRelation::kOutside);
+}
+
 }  // namespace
 }  // namespace trajroi::roi
