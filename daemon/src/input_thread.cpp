@@ -61,9 +61,9 @@ bool decode_ahead(const Pipeline& pipeline, InputLane& lane, const InputSlot& sl
 void input_loop(Pipeline& pipeline, InputLane& lane) {
   if (const std::string w = apply_thread_config(lane.thread_name.c_str(), lane.thread); !w.empty()) log::warn("{}", w);
   prefault_stack();
-  const std::int64_t cpu_start = thread_cpu_ns();
+  const std::int64_t cpu_start = host::thread_cpu_ns();
   inputs::InputSource& source = *lane.source;
-  Ring<InputSlot>& ring = *lane.ring;
+  InputRing& ring = *lane.ring;
   log::RateLimited error_limit(pipeline.config.logging.warning_interval_s);
   // The processing thread is woken once per batch of items, not per item: items that arrive
   // together go together (capped, so a replay running behind still wakes it); an item alone
@@ -81,21 +81,12 @@ void input_loop(Pipeline& pipeline, InputLane& lane) {
   int unnotified = 0;
   std::int64_t held_since_ns = 0;
   std::uint32_t items = 0;
-  // An as-fast replay's full ring: the reader sleeps while the processing thread empties about
-  // an eighth of it (a LiDAR packet takes it a few µs), not waking every few items to find
-  // the ring full again (at 50 µs that was a fifth of the reader's CPU).
-  const auto full_sleep =
-      std::chrono::microseconds(std::clamp<std::int64_t>(static_cast<std::int64_t>(ring.capacity() / 2), 20, 500));
-  const auto on_full = [&pipeline, full_sleep] {
-    pipeline.process_wake.notify();
-    std::this_thread::sleep_for(full_sleep);
-  };
   inputs::InputItem item;
   while (!pipeline.stop.load(std::memory_order_relaxed)) {
     // Held items bound the wait: they go when their time is up even if nothing follows.
     std::int64_t wait_ms = kIdleWait_ms;
     if (unnotified > 0)
-      wait_ms = std::max<std::int64_t>(1, (held_since_ns + kMaxHold_ns - steady_ns() + 999'999) / 1'000'000);
+      wait_ms = std::max<std::int64_t>(1, (held_since_ns + kMaxHold_ns - host::monotonic_ns() + 999'999) / 1'000'000);
     const auto next = source.next(item, std::chrono::milliseconds(wait_ms));
     if (next != inputs::InputSource::Next::kItem) {
       copy_counters(source, lane);
@@ -117,7 +108,7 @@ void input_loop(Pipeline& pipeline, InputLane& lane) {
     }
     if (next == inputs::InputSource::Next::kError) {
       std::uint64_t suppressed = 0;
-      if (error_limit.allow(steady_ns(), suppressed)) {
+      if (error_limit.allow(host::monotonic_ns(), suppressed)) {
         log::warn("{}: {}{}", source.describe(), source.error(),
                   suppressed > 0 ? " (" + std::to_string(suppressed) + " similar suppressed)" : std::string());
       }
@@ -135,26 +126,25 @@ void input_loop(Pipeline& pipeline, InputLane& lane) {
         slot.stream = item.stream;
         slot.size = static_cast<std::uint16_t>(piece.size());
         std::copy(piece.begin(), piece.end(), slot.bytes.begin());
-        slot.arrival_ns = steady_ns();  // before decoding: the latency figures include it
+        slot.arrival_ns = host::monotonic_ns();  // before decoding: the latency figures include it
         slot.seq = pipeline.sequence.fetch_add(1, std::memory_order_relaxed);
         slot.decoded = decode_ahead(pipeline, lane, slot);
       };
-      const bool pushed = pipeline.exact ? ring.push_wait(fill, pipeline.stop, on_full) : ring.try_push(fill);
-      if (!pushed) lane.ring_drops[static_cast<std::size_t>(item.stream)].fetch_add(1, std::memory_order_relaxed);
+      (void)ring.push(fill, static_cast<std::size_t>(item.stream));  // a drop is counted by the ring, by stream
     } while (!rest.empty());
     if ((++items & 255U) == 0) copy_counters(source, lane);  // current under constant traffic
-    if (unnotified++ == 0) held_since_ns = steady_ns();
+    if (unnotified++ == 0) held_since_ns = host::monotonic_ns();
     // An as-fast replay's processing thread that waits for input is woken at once: it would
     // idle for the batch. (A flag seen too late delays it to the batch's end, as before.)
     const bool waits = pipeline.exact && pipeline.processing_waits.load();
     if (waits || unnotified >= max_batch || wake_now(item, cut_cdeg, drain_cdeg) ||
-        (!source.ready() && steady_ns() - held_since_ns >= kMaxHold_ns)) {
+        (!source.ready() && host::monotonic_ns() - held_since_ns >= kMaxHold_ns)) {
       pipeline.process_wake.notify();
       unnotified = 0;
     }
   }
   copy_counters(source, lane);
-  pipeline.cpu_sources_ns.fetch_add(thread_cpu_ns() - cpu_start);
+  pipeline.cpu_sources_ns.fetch_add(host::thread_cpu_ns() - cpu_start);
   lane.done.store(true, std::memory_order_release);
   pipeline.process_wake.notify();
 }

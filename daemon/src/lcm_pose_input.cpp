@@ -6,6 +6,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "trajroi/host/clock.hpp"
+
 namespace trajroi::daemon {
 
 LcmPoseInput::LcmPoseInput(const std::string& url, std::string channel, const std::optional<sockaddr_in>& exclude)
@@ -29,7 +31,7 @@ void LcmPoseInput::enqueue(std::span<const std::uint8_t> message) {
     ++oversize_;
     return;
   }
-  const std::int64_t offset = inputs::realtime_ns() - inputs::monotonic_ns();
+  const std::int64_t offset = host::realtime_ns() - host::monotonic_ns();
   std::vector<std::uint8_t> bytes(8 + message.size());
   for (int i = 0; i < 8; ++i)
     bytes[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(static_cast<std::uint64_t>(offset) >> (8 * i));
@@ -60,7 +62,7 @@ inputs::InputSource::Next LcmPoseInput::next(inputs::InputItem& item, std::chron
   queued_.pop_front();
   item.stream = inputs::Stream::kPose;
   item.bytes = current_;
-  item.receive_ns = inputs::monotonic_ns();
+  item.receive_ns = host::monotonic_ns();
   ++items_;
   return Next::kItem;
 }

@@ -139,7 +139,7 @@ int main(int argc, char** argv) {
     }
   }
   // The trajectory file is part of the configuration: read once, here.
-  std::unique_ptr<ActiveTrajectory> trajectory;
+  std::unique_ptr<trajroi::pipeline::ActiveTrajectory> trajectory;
   try {
     trajectory = load_trajectory(TrajectorySource::from(config));
   } catch (const std::exception& e) {

@@ -19,7 +19,7 @@ void copy_into(std::vector<T>& out, const std::vector<T, Allocator>& in) {
   out.assign(in.begin(), in.end());
 }
 
-void set_pose(const PublishedPose& p, double (&position)[3], double (&orientation)[4]) {
+void set_pose(const pipeline::PublishedPose& p, double (&position)[3], double (&orientation)[4]) {
   for (int i = 0; i < 3; ++i)
     position[i] = p.position_m[i];
   orientation[0] = p.orientation.w();
@@ -60,7 +60,7 @@ std::uint8_t* store_be32_array(std::uint8_t* out, const std::vector<T, Allocator
 }
 
 // Every field of points_t but the points.
-void fill_points_head(const Sweep& sweep, PoseMode mode, trajroi::points_t& out) {
+void fill_points_head(const pipeline::Sweep& sweep, PoseMode mode, trajroi::points_t& out) {
   out.sweep_index = static_cast<std::int64_t>(sweep.index);
   out.sweep_start_ns = sweep.start_ns;
   out.sweep_end_ns = sweep.end_ns;
@@ -78,7 +78,7 @@ void fill_points_head(const Sweep& sweep, PoseMode mode, trajroi::points_t& out)
 
 }  // namespace
 
-void fill_pose(const Sweep& sweep, trajroi::pose_t& out) {
+void fill_pose(const pipeline::Sweep& sweep, trajroi::pose_t& out) {
   out.t_ns = sweep.pose_t_ns;
   out.sweep_index = static_cast<std::int64_t>(sweep.index);
   out.valid = sweep.pose_status == pose::PoseStatus::kValid;
@@ -95,7 +95,7 @@ void fill_pose(const Sweep& sweep, trajroi::pose_t& out) {
   out.h_acc_m = sweep.fix.h_acc_m;
 }
 
-void fill_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& out) {
+void fill_points(const pipeline::Sweep& sweep, PoseMode mode, trajroi::points_t& out) {
   fill_points_head(sweep, mode, out);
   out.num_points = static_cast<std::int32_t>(sweep.size());
   copy_into(out.x, sweep.x);
@@ -107,7 +107,8 @@ void fill_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& out) {
   copy_into(out.time_offset_ns, sweep.time_offset_ns);
 }
 
-void encode_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& head, std::vector<std::uint8_t>& out) {
+void encode_points(const pipeline::Sweep& sweep, PoseMode mode, trajroi::points_t& head,
+                   std::vector<std::uint8_t>& out) {
   fill_points_head(sweep, mode, head);
   head.num_points = 0;  // the arrays empty: num_points is the head's last field, patched below
   head.x.clear();
@@ -133,7 +134,7 @@ void encode_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& head, s
   (void)store_be32_array(p, sweep.time_offset_ns);
 }
 
-void fill_roi(const Sweep& sweep, trajroi::roi_t& out) {
+void fill_roi(const pipeline::Sweep& sweep, trajroi::roi_t& out) {
   out.sweep_index = static_cast<std::int64_t>(sweep.index);
   out.t_ns = sweep.start_ns;
   out.trajectory_id = sweep.trajectory_id;
@@ -216,7 +217,8 @@ TrajectoryCheck check_trajectory(const trajroi::trajectory_t& m, const pose::Glo
     }
   }
   try {
-    r.trajectory = std::make_unique<ActiveTrajectory>(ActiveTrajectory{roi::Trajectory(std::move(points)), m.id});
+    r.trajectory = std::make_unique<pipeline::ActiveTrajectory>(
+        pipeline::ActiveTrajectory{roi::Trajectory(std::move(points)), m.id});
   } catch (const roi::TrajectoryError& e) {
     return reject(TrajectoryReject::kTooFewWaypoints, e.what());
   }

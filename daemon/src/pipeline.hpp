@@ -11,16 +11,20 @@
 #include <array>
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "trajroi/daemon/config.hpp"
-#include "trajroi/daemon/sweep_processor.hpp"
+#include "trajroi/host/clock.hpp"
 #include "trajroi/inputs/input_source.hpp"
+#include "trajroi/pipeline/sweep_processor.hpp"
+#include "trajroi/transport/ring_lane.hpp"
 #include "trajroi/transport/spsc_ring.hpp"
 #include "trajroi/vlp16/stream_decoder.hpp"
 
@@ -28,6 +32,10 @@ namespace trajroi::daemon {
 
 template <typename T>
 using Ring = transport::SpscRing<T>;
+// The rings between the threads whose policy is the pipeline's (Pipeline::exact); drops are
+// counted by the lane, per input stream for the input lanes.
+template <typename T, std::size_t Kinds = 1>
+using Lane = transport::RingLane<T, Kinds>;
 
 inline constexpr std::size_t kMaxItemBytes = inputs::kMaxDatagramBytes;  // a slot holds any datagram
 inline constexpr int kIdleWait_ms = 100;                                 // every loop wakes at least this often
@@ -37,10 +45,6 @@ inline constexpr std::size_t kDecodeAhead = 128;
 // … while that thread is busy and at least this many items (a quarter of a smaller ring) wait
 // in its ring.
 inline constexpr std::size_t kDecodeAheadBacklog = 16;
-
-// CLOCK_MONOTONIC and the calling thread's CPU time, ns.
-[[nodiscard]] std::int64_t steady_ns() noexcept;
-[[nodiscard]] std::int64_t thread_cpu_ns() noexcept;
 
 class EventFd {
  public:
@@ -80,10 +84,12 @@ struct InputSlot {
   std::array<std::uint8_t, kMaxItemBytes> bytes{};
 };
 
+using InputRing = Lane<InputSlot, inputs::kStreamCount>;
+
 // One input source with its reader thread's ring and what that thread counted.
 struct InputLane {
   std::unique_ptr<inputs::InputSource> source;
-  std::unique_ptr<Ring<InputSlot>> ring;
+  std::unique_ptr<InputRing> ring;  // its drops counted by stream
   // The points of the LiDAR data packets in `ring` that the input thread decoded ahead, in the
   // same order (made with the lane when its source may carry LiDAR data; else null).
   std::unique_ptr<Ring<vlp16::DecodedPacket>> decoded;
@@ -92,11 +98,10 @@ struct InputLane {
   std::atomic<bool> done{false};
   // Copied from the source's counters by the reader, for the status.
   std::atomic<std::uint64_t> oversize{0}, errors{0}, disconnects{0}, rejected_sources{0}, kernel_drops{0};
-  std::array<std::atomic<std::uint64_t>, inputs::kStreamCount> ring_drops{};  // by stream
 };
 
 struct TrajectoryItem {
-  std::unique_ptr<ActiveTrajectory> trajectory;
+  std::unique_ptr<pipeline::ActiveTrajectory> trajectory;
 };
 
 struct StatusSnapshot;
@@ -120,6 +125,10 @@ struct Pipeline {
   InputLane& add_input(std::unique_ptr<inputs::InputSource> source, std::size_t ring_capacity, std::string thread_name,
                        const ThreadConfig& thread, Lidar lidar = Lidar::kMayCarry);
   [[nodiscard]] bool inputs_done() const noexcept;
+  // kWait when exact, else kDrop: the policy of the lanes between the threads.
+  [[nodiscard]] transport::FullRing policy() const noexcept;
+  // A full exact lane's wait: wake its consumer, sleep.
+  static std::function<void()> wake_and_sleep(const EventFd& consumer, std::chrono::microseconds sleep);
   [[nodiscard]] bool inputs_empty() const noexcept;
 
   const DaemonConfig& config;
@@ -131,11 +140,11 @@ struct Pipeline {
   std::atomic<std::uint64_t> sequence{0};
   EventFd process_wake, publish_wake, record_wake, main_wake;
   std::vector<std::unique_ptr<InputLane>> inputs;
-  Ring<Sweep> sweeps;
+  Lane<pipeline::Sweep> sweeps;
   std::unique_ptr<Ring<StatusSnapshot>> status;
   Ring<TrajectoryItem> trajectories_in;     // publisher → processing
   Ring<TrajectoryItem> trajectories_out;    // processing → publisher (to free)
-  std::unique_ptr<Ring<InputSlot>> record;  // processing → recorder, when recording
+  std::unique_ptr<Lane<InputSlot>> record;  // processing → recorder, when recording
   std::atomic<bool> processing_done{false}, publishing_done{false};
   // The processing thread is about to wait for input, or waits: an as-fast-as-possible
   // replay's reader then wakes it at once instead of at the end of its batch.

@@ -18,25 +18,19 @@ constexpr std::int64_t kSecond_ns = 1'000'000'000;
 
 // Hands each finished sweep to the publisher's ring (its points exchanged with a preallocated
 // slot's) with the processing time it took.
-class RingSink final : public SweepSink {
+class RingSink final : public pipeline::SweepSink {
  public:
   explicit RingSink(Pipeline& pipeline) : pipeline_(pipeline) {}
-  void on_sweep(Sweep& sweep) override {
-    const std::int64_t now = steady_ns();
-    const auto fill = [&](Sweep& slot) {
+  void on_sweep(pipeline::Sweep& sweep) override {
+    const std::int64_t now = host::monotonic_ns();
+    const auto fill = [&](pipeline::Sweep& slot) {
       slot.take(sweep);  // arrays of the same reserved capacity exchanged: no allocation
       slot.processing_ns = accumulated_ns_ + (now - packet_start_ns_);
       slot.closing_packet_start_ns = packet_start_ns_;
       slot.handed_over_ns = now;
     };
-    const auto on_full = [this] {
-      pipeline_.publish_wake.notify();
-      std::this_thread::sleep_for(std::chrono::microseconds(20));
-    };
     // An as-fast-as-possible replay waits for the publisher (exact output); live drops.
-    const bool pushed =
-        pipeline_.exact ? pipeline_.sweeps.push_wait(fill, pipeline_.stop, on_full) : pipeline_.sweeps.try_push(fill);
-    if (pushed) pipeline_.publish_wake.notify();
+    if (pipeline_.sweeps.push(fill)) pipeline_.publish_wake.notify();
     accumulated_ns_ = 0;
     packet_start_ns_ = now;
   }
@@ -51,7 +45,7 @@ class RingSink final : public SweepSink {
 
 class Processing {
  public:
-  Processing(Pipeline& pipeline, SweepProcessor& processor)
+  Processing(Pipeline& pipeline, pipeline::SweepProcessor& processor)
       : pipeline_(pipeline), processor_(processor), sink_(pipeline) {}
 
   // The lane whose front item (`front`) is oldest in the global order, or null when all are empty.
@@ -72,41 +66,21 @@ class Processing {
   void handle(InputLane& lane, InputSlot& item) {
     const std::span<const std::uint8_t> bytes(item.bytes.data(), item.size);
     last_receive_ns_ = std::max(last_receive_ns_, item.receive_ns);
-    switch (item.stream) {
-      case inputs::Stream::kLidarData:
-      case inputs::Stream::kLidarPosition: {
-        const std::int64_t start = steady_ns();
-        sink_.packet_started(start);
-        processor_.set_input_arrival(item.arrival_ns);
-        // A data packet decoded ahead by its input thread: its points are first in that lane's
-        // ring of decoded packets (the tag is a guard: never another packet's points).
-        vlp16::DecodedPacket* ahead = item.decoded ? lane.decoded->front() : nullptr;
-        processor_.lidar_datagram(item.stream == inputs::Stream::kLidarData ? LidarPort::kData : LidarPort::kPosition,
-                                  bytes, item.receive_ns, sink_,
-                                  ahead != nullptr && ahead->tag == item.seq ? ahead : nullptr);
-        if (ahead != nullptr) lane.decoded->release();
-        sink_.packet_done(steady_ns());
-        break;
-      }
-      case inputs::Stream::kGnss:
-        processor_.gnss_bytes(bytes, item.receive_ns);
-        break;
-      case inputs::Stream::kImu:
-        processor_.imu_bytes(bytes, item.receive_ns);
-        break;
-      case inputs::Stream::kPose:
-        processor_.pose_message(bytes, item.receive_ns);
-        break;
+    const inputs::InputItem input{item.stream, bytes, item.receive_ns};
+    if (inputs::is_lidar(item.stream)) {
+      const std::int64_t start = host::monotonic_ns();
+      sink_.packet_started(start);
+      processor_.set_input_arrival(item.arrival_ns);
+      // A data packet decoded ahead by its input thread: its points are first in that lane's
+      // ring of decoded packets (the tag is a guard: never another packet's points).
+      vlp16::DecodedPacket* ahead = item.decoded ? lane.decoded->front() : nullptr;
+      processor_.process(input, sink_, ahead != nullptr && ahead->tag == item.seq ? ahead : nullptr);
+      if (ahead != nullptr) lane.decoded->release();
+      sink_.packet_done(host::monotonic_ns());
+    } else {
+      processor_.process(input, sink_);
     }
-    if (pipeline_.record) {
-      const auto on_full = [this] {
-        pipeline_.record_wake.notify();
-        std::this_thread::sleep_for(std::chrono::microseconds(20));
-      };
-      const auto copy = [&item](InputSlot& slot) { slot = item; };
-      (void)(pipeline_.exact ? pipeline_.record->push_wait(copy, pipeline_.stop, on_full)
-                             : pipeline_.record->try_push(copy));
-    }
+    if (pipeline_.record) (void)pipeline_.record->push([&item](InputSlot& slot) { slot = item; });
     lane.ring->release();
   }
 
@@ -130,13 +104,13 @@ class Processing {
   }
 
   void run(const ProcessingOptions& options) {
-    std::int64_t next_status = steady_ns() + kSecond_ns;
-    if (options.live) processor_.set_host_utc_offset(inputs::realtime_ns() - inputs::monotonic_ns());
+    std::int64_t next_status = host::monotonic_ns() + kSecond_ns;
+    if (options.live) processor_.set_host_utc_offset(host::realtime_ns() - host::monotonic_ns());
     const std::int64_t stall_at = options.stall_after_s
-                                      ? steady_ns() + static_cast<std::int64_t>(*options.stall_after_s * 1e9)
+                                      ? host::monotonic_ns() + static_cast<std::int64_t>(*options.stall_after_s * 1e9)
                                       : std::numeric_limits<std::int64_t>::max();
     for (;;) {
-      if (steady_ns() >= stall_at) {
+      if (host::monotonic_ns() >= stall_at) {
         log::warn("fault injection: the processing thread stops making progress");
         while (!pipeline_.stop.load(std::memory_order_relaxed))
           std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -154,9 +128,9 @@ class Processing {
       }
       if (handled > 0 && pipeline_.record) pipeline_.record_wake.notify();
 
-      const std::int64_t now = steady_ns();
+      const std::int64_t now = host::monotonic_ns();
       if (now >= next_status) {
-        if (options.live) processor_.set_host_utc_offset(inputs::realtime_ns() - inputs::monotonic_ns());
+        if (options.live) processor_.set_host_utc_offset(host::realtime_ns() - host::monotonic_ns());
         snapshot(false);
         next_status += kSecond_ns;
         if (next_status < now) next_status = now + kSecond_ns;
@@ -179,21 +153,21 @@ class Processing {
 
  private:
   Pipeline& pipeline_;
-  SweepProcessor& processor_;
+  pipeline::SweepProcessor& processor_;
   RingSink sink_;
   std::int64_t last_receive_ns_ = 0;
 };
 
 }  // namespace
 
-void processing_loop(Pipeline& pipeline, SweepProcessor& processor, const ProcessingOptions& options) {
+void processing_loop(Pipeline& pipeline, pipeline::SweepProcessor& processor, const ProcessingOptions& options) {
   if (const std::string w = apply_thread_config("trajroid-proc", pipeline.config.realtime.processing); !w.empty()) {
     log::warn("{}", w);
   }
   prefault_stack();
-  const std::int64_t cpu_start = thread_cpu_ns();
+  const std::int64_t cpu_start = host::thread_cpu_ns();
   Processing(pipeline, processor).run(options);
-  pipeline.cpu_processing_ns.fetch_add(thread_cpu_ns() - cpu_start);
+  pipeline.cpu_processing_ns.fetch_add(host::thread_cpu_ns() - cpu_start);
   pipeline.processing_done.store(true, std::memory_order_release);
   pipeline.publish_wake.notify();
   pipeline.record_wake.notify();

@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "realtime.hpp"
+#include "trajroi/host/clock.hpp"
 #include "trajroi/inputs/input_source.hpp"
 #include "trajroi/status_t.hpp"
 
@@ -43,7 +44,7 @@ Publisher::Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, boo
       replay_(replay),
       config_(pipeline.config),
       frame_(pose::GlobalFrame::local_cartesian(pipeline.config.origin)),
-      start_steady_ns_(steady_ns()),
+      start_steady_ns_(host::monotonic_ns()),
       health_(pipeline.config, !replay, start_steady_ns_),
       sweep_warn_limit_(pipeline.config.logging.warning_interval_s),
       trajectory_warn_limit_(pipeline.config.logging.warning_interval_s),
@@ -66,7 +67,7 @@ Publisher::Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, boo
 
 void Publisher::warn_rate_limited(log::RateLimited& limit, const std::string& message) {
   std::uint64_t suppressed = 0;
-  if (limit.allow(steady_ns(), suppressed)) {
+  if (limit.allow(host::monotonic_ns(), suppressed)) {
     if (suppressed > 0) {
       log::warn("{} ({} similar warnings suppressed)", message, suppressed);
     } else {
@@ -83,7 +84,7 @@ void Publisher::send(const std::string& channel, const Message& m) {
   outlet_.publish(channel, std::span<const std::uint8_t>(encoded_.data(), static_cast<std::size_t>(size)));
 }
 
-void Publisher::offer(std::unique_ptr<ActiveTrajectory> trajectory) {
+void Publisher::offer(std::unique_ptr<pipeline::ActiveTrajectory> trajectory) {
   const bool pushed = pipeline_.trajectories_in.try_push(
       [&trajectory](TrajectoryItem& slot) { slot.trajectory = std::move(trajectory); });
   if (pushed) pipeline_.process_wake.notify();
@@ -134,20 +135,20 @@ void Publisher::report_late(const SweepTiming& t, std::int64_t sent_ns) {
             suppressed > 0 ? " (" + std::to_string(suppressed) + " late sweeps not described)" : std::string());
 }
 
-void Publisher::publish_sweep(const Sweep& s) {
-  const std::int64_t dequeued_ns = steady_ns();
+void Publisher::publish_sweep(const pipeline::Sweep& s) {
+  const std::int64_t dequeued_ns = host::monotonic_ns();
   fill_pose(s, pose_);
   send(config_.lcm.pose, pose_);
   if (s.filtered) {
     fill_roi(s, roi_);
     send(config_.lcm.roi, roi_);
     encode_points(s, config_.pose_mode, points_, points_encoded_);
-    const std::int64_t encoded_ns = steady_ns();
+    const std::int64_t encoded_ns = host::monotonic_ns();
     outlet_.publish(config_.lcm.points, points_encoded_);
     // A partial sweep's latency (the stream's end, flushed at a stop) is the wait for the stop,
     // not the pipeline's: left out of the figures.
     if (!s.partial) {
-      const std::int64_t sent_ns = steady_ns();
+      const std::int64_t sent_ns = host::monotonic_ns();
       const auto ms = [](std::int64_t from, std::int64_t to) { return static_cast<double>(to - from) * 1e-6; };
       const SweepTiming timing{.index = s.index,
                                .total_ms = ms(s.last_packet_arrival_ns, sent_ns),
@@ -174,7 +175,7 @@ void Publisher::publish_sweep(const Sweep& s) {
 
 void Publisher::publish_status(const StatusSnapshot& s) {
   trajroi::status_t m;
-  m.wall_time_ns = inputs::realtime_ns();
+  m.wall_time_ns = host::realtime_ns();
   m.uptime_s = static_cast<double>(s.steady_ns - start_steady_ns_) * 1e-9;
   m.replay = replay_;
   m.final_status = s.final;
@@ -264,7 +265,7 @@ void Publisher::log_minute(const StatusSnapshot& s) {
 }
 
 void Publisher::publish_pending_sweeps() {
-  while (Sweep* s = pipeline_.sweeps.front()) {
+  while (pipeline::Sweep* s = pipeline_.sweeps.front()) {
     publish_sweep(*s);
     pipeline_.sweeps.release();
   }
@@ -274,14 +275,14 @@ void Publisher::run() {
   if (const std::string w = apply_thread_config("trajroid-pub", config_.realtime.publisher); !w.empty()) {
     log::warn("{}", w);
   }
-  const std::int64_t cpu_start = thread_cpu_ns();
+  const std::int64_t cpu_start = host::thread_cpu_ns();
   latency_window_ms_.reserve(4096);
   processing_window_ms_.reserve(4096);
   latency_minute_ms_.reserve(1U << 16);
   if (!pipeline_.exact) {
     // The largest sweep's encoding, resident from the start (see Pipeline::exact; a page over
     // for the head, whose size is that of an empty sweep's).
-    encode_points(Sweep{}, config_.pose_mode, points_, points_encoded_);
+    encode_points(pipeline::Sweep{}, config_.pose_mode, points_, points_encoded_);
     points_encoded_.resize(points_encoded_.size() + 4096 +
                            config_.buffers.max_points_per_sweep * kEncodedBytesPerPoint);
     points_encoded_.clear();
@@ -314,7 +315,7 @@ void Publisher::run() {
       break;
     }
   }
-  pipeline_.cpu_publishing_ns.fetch_add(thread_cpu_ns() - cpu_start);
+  pipeline_.cpu_publishing_ns.fetch_add(host::thread_cpu_ns() - cpu_start);
   pipeline_.publishing_done.store(true, std::memory_order_release);
   pipeline_.main_wake.notify();
 }

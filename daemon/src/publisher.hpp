@@ -35,8 +35,8 @@ class Publisher {
 
  private:
   void on_trajectory_message(std::span<const std::uint8_t> bytes, const std::string& channel);
-  void offer(std::unique_ptr<ActiveTrajectory> trajectory);
-  void publish_sweep(const Sweep& s);
+  void offer(std::unique_ptr<pipeline::ActiveTrajectory> trajectory);
+  void publish_sweep(const pipeline::Sweep& s);
   // Every sweep in the ring, oldest first.
   void publish_pending_sweeps();
   // Where a sweep's time went, from its last packet's arrival to its points sent.

@@ -17,7 +17,7 @@ void record_to(Pipeline& pipeline, const std::filesystem::path& dir) {
   serial::RecordingWriter gnss((dir / inputs::kGnssFile).string());
   serial::RecordingWriter imu((dir / inputs::kImuFile).string());
   std::unique_ptr<serial::RecordingWriter> pose;  // made at the first pose message
-  Ring<InputSlot>& ring = *pipeline.record;
+  Lane<InputSlot>& ring = *pipeline.record;
   for (;;) {
     bool any = false;
     while (InputSlot* s = ring.front()) {

@@ -12,8 +12,8 @@
 #include <thread>
 #include <vector>
 
-#include "trajroi/daemon/sweep_processor.hpp"
 #include "trajroi/daemon/trajectory_file.hpp"
+#include "trajroi/pipeline/sweep_processor.hpp"
 
 namespace trajroi::daemon {
 
@@ -22,7 +22,7 @@ class EventFd;
 class Reloader {
  public:
   struct Result {
-    std::unique_ptr<ActiveTrajectory> trajectory;  // or why not:
+    std::unique_ptr<pipeline::ActiveTrajectory> trajectory;  // or why not:
     std::string error;
   };
   // Starts the thread; `done` is notified when a result is ready.

@@ -101,10 +101,10 @@ std::uint64_t StatusSnapshot::ring_drops() const noexcept {
   return drops;
 }
 
-void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64_t last_receive_ns, bool final,
-                   StatusSnapshot& s) {
+void fill_snapshot(const pipeline::SweepProcessor& p, const Pipeline& pipeline, std::int64_t last_receive_ns,
+                   bool final, StatusSnapshot& s) {
   const vlp16::StreamCounters& l = p.lidar_counters();
-  s.steady_ns = steady_ns();
+  s.steady_ns = host::monotonic_ns();
   s.final = final;
   s.trajectory_id = p.active_trajectory_id();
   s.processor = p.counters();
@@ -112,7 +112,7 @@ void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64
   s.position_packets = l.position_packets;
   s.lost_packets = l.lost_packets;
   s.decode_errors = l.rejected_total();
-  const Sweep& current = p.current();
+  const pipeline::Sweep& current = p.current();
   s.pose_valid = current.pose_status == pose::PoseStatus::kValid;
   s.pose_status = current.pose_status;
   const pose::GnssFix* fix = p.poses().newest_fix();
@@ -135,9 +135,7 @@ void fill_snapshot(const SweepProcessor& p, const Pipeline& pipeline, std::int64
 
   s.counters.fill(0);
   for (const auto& lane : pipeline.inputs) {
-    const auto drops = [&lane](inputs::Stream st) {
-      return lane->ring_drops[static_cast<std::size_t>(st)].load(std::memory_order_relaxed);
-    };
+    const auto drops = [&lane](inputs::Stream st) { return lane->ring->dropped(static_cast<std::size_t>(st)); };
     s[C::kRingDropsLidar] += drops(inputs::Stream::kLidarData) + drops(inputs::Stream::kLidarPosition);
     s[C::kRingDropsGnss] += drops(inputs::Stream::kGnss);
     s[C::kRingDropsImu] += drops(inputs::Stream::kImu);

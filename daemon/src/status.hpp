@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "trajroi/daemon/sweep_processor.hpp"
+#include "trajroi/pipeline/sweep_processor.hpp"
 #include "trajroi/pose/pose_buffer.hpp"
 #include "trajroi/vlp16/packet.hpp"
 #include "trajroi/vlp16/position.hpp"
@@ -84,7 +84,7 @@ inline constexpr std::size_t kCounterCount = static_cast<std::size_t>(Counter::k
 struct StatusSnapshot {
   std::int64_t steady_ns = 0;
   std::int32_t trajectory_id = 0;
-  ProcessorCounters processor;
+  pipeline::ProcessorCounters processor;
   std::uint64_t lidar_packets = 0, position_packets = 0, lost_packets = 0, decode_errors = 0;
   bool pose_valid = false;
   pose::PoseStatus pose_status = pose::PoseStatus::kNoGnss;
@@ -108,7 +108,7 @@ struct StatusSnapshot {
 };
 
 // Fills `s` from the processor (processing thread) and the pipeline's rings and inputs.
-void fill_snapshot(const SweepProcessor& processor, const Pipeline& pipeline, std::int64_t last_receive_ns, bool final,
-                   StatusSnapshot& s);
+void fill_snapshot(const pipeline::SweepProcessor& processor, const Pipeline& pipeline, std::int64_t last_receive_ns,
+                   bool final, StatusSnapshot& s);
 
 }  // namespace trajroi::daemon

@@ -7,9 +7,11 @@
 
 #include "pipeline.hpp"
 
-namespace trajroi::daemon {
-
+namespace trajroi::pipeline {
 class SweepProcessor;
+}  // namespace trajroi::pipeline
+
+namespace trajroi::daemon {
 
 // input_thread.cpp: reads one source into its lane's ring until the stop flag or the end of a
 // recording; serial reads longer than a slot are split (same receive time); a datagram longer
@@ -25,7 +27,7 @@ struct ProcessingOptions {
   std::optional<double> stall_after_s;
   bool live = true;  // the host clock's UTC offset is the inputs' (false in a replay)
 };
-void processing_loop(Pipeline& pipeline, SweepProcessor& processor, const ProcessingOptions& options);
+void processing_loop(Pipeline& pipeline, pipeline::SweepProcessor& processor, const ProcessingOptions& options);
 
 // recorder.cpp: writes every item the processing thread handled into `dir` (lidar.pcap,
 // gnss.trjb, imu.trjb: a run folder that replays to the same output).

@@ -98,9 +98,9 @@ roi::Trajectory parse_trajectory(std::string_view text, const TrajectorySource& 
   }
 }
 
-std::unique_ptr<ActiveTrajectory> load_trajectory(const TrajectorySource& source) {
-  return std::make_unique<ActiveTrajectory>(
-      ActiveTrajectory{parse_trajectory(config::read_text_file(source.file), source), 0});
+std::unique_ptr<pipeline::ActiveTrajectory> load_trajectory(const TrajectorySource& source) {
+  return std::make_unique<pipeline::ActiveTrajectory>(
+      pipeline::ActiveTrajectory{parse_trajectory(config::read_text_file(source.file), source), 0});
 }
 
 }  // namespace trajroi::daemon

@@ -131,7 +131,7 @@ int block_signals() {
 void log_summary(const Pipeline& pipeline, const Publisher& publisher, std::int64_t start_ns, bool replay) {
   const StatusSnapshot& s = publisher.last_status();
   const LatencyHistogram& latency = publisher.latency();
-  const double wall_s = static_cast<double>(steady_ns() - start_ns) * 1e-9;
+  const double wall_s = static_cast<double>(host::monotonic_ns() - start_ns) * 1e-9;
   const auto& p = s.processor;
   log::info(
       "summary: {:.3f} s | sweeps {} published {} withheld (no pose) {} | points in {} kept {} ({:.1f} %) | "
@@ -147,9 +147,9 @@ void log_summary(const Pipeline& pipeline, const Publisher& publisher, std::int6
 
 }  // namespace
 
-int run_pipeline(Pipeline& pipeline, SweepProcessor& processor, Outlet& outlet, const RunOptions& options,
+int run_pipeline(Pipeline& pipeline, pipeline::SweepProcessor& processor, Outlet& outlet, const RunOptions& options,
                  bool signals) {
-  const std::int64_t start_ns = steady_ns();
+  const std::int64_t start_ns = host::monotonic_ns();
   const int sfd = signals ? block_signals() : -1;
   pipeline.lidar_decoder = &processor.packet_decoder();  // the input threads decode ahead with it
   Reloader reloader(TrajectorySource::from(pipeline.config), pipeline.publish_wake);
@@ -209,12 +209,13 @@ int run_pipeline(Pipeline& pipeline, SweepProcessor& processor, Outlet& outlet, 
   return 0;
 }
 
-int run_daemon(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> trajectory, const RunOptions& options) {
-  std::unique_ptr<SweepProcessor> processor;
+int run_daemon(const DaemonConfig& config, std::unique_ptr<pipeline::ActiveTrajectory> trajectory,
+               const RunOptions& options) {
+  std::unique_ptr<pipeline::SweepProcessor> processor;
   try {
     log::info("trajectory: {} ({} waypoints, {:.1f} m)", config.trajectory_file.string(),
               trajectory->trajectory.waypoints().size(), trajectory->trajectory.length_m());
-    processor = std::make_unique<SweepProcessor>(config, std::move(trajectory));
+    processor = std::make_unique<pipeline::SweepProcessor>(config, std::move(trajectory));
   } catch (const std::exception& e) {
     // The lidar calibration: part of the configuration.
     log::critical("{}: {}", config.file.string(), e.what());

@@ -9,11 +9,14 @@
 
 #include "trajroi/daemon/config.hpp"
 
+namespace trajroi::pipeline {
+class SweepProcessor;
+struct ActiveTrajectory;
+}  // namespace trajroi::pipeline
+
 namespace trajroi::daemon {
 
 struct Pipeline;
-class SweepProcessor;
-struct ActiveTrajectory;
 class Outlet;
 
 struct RunOptions {
@@ -30,12 +33,13 @@ struct RunOptions {
 };
 
 // Runs until SIGTERM / SIGINT, or the end of a replay. Returns the process exit code.
-int run_daemon(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> trajectory, const RunOptions& options);
+int run_daemon(const DaemonConfig& config, std::unique_ptr<pipeline::ActiveTrajectory> trajectory,
+               const RunOptions& options);
 
 // The pipeline's threads over the inputs already added to `pipeline`, until the inputs end or
 // `pipeline.stop` is set (by SIGTERM / SIGINT when `signals`; SIGHUP then reloads the
 // trajectory). Logs the summary; returns the exit code. What run_daemon and the tests call.
-int run_pipeline(Pipeline& pipeline, SweepProcessor& processor, Outlet& outlet, const RunOptions& options,
+int run_pipeline(Pipeline& pipeline, pipeline::SweepProcessor& processor, Outlet& outlet, const RunOptions& options,
                  bool signals);
 
 }  // namespace trajroi::daemon

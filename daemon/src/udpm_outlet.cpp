@@ -49,7 +49,7 @@ UdpmOutlet::~UdpmOutlet() {
 void UdpmOutlet::publish(const std::string& channel, std::span<const std::uint8_t> bytes) {
   std::uint64_t suppressed = 0;
   if (!udpm::split_message(channel, bytes, seqno_, datagrams_)) {
-    if (send_limit_.allow(steady_ns(), suppressed))
+    if (send_limit_.allow(host::monotonic_ns(), suppressed))
       log::error("LCM {}: a {} B message on '{}' cannot be sent (channel of 1 … 63 bytes, at most 65 535 fragments)",
                  url_, bytes.size(), channel);
     return;
@@ -75,7 +75,7 @@ void UdpmOutlet::publish(const std::string& channel, std::span<const std::uint8_
     const int sent = sendmmsg(send_fd_, headers.data(), static_cast<unsigned>(count), 0);
     if (sent <= 0) {
       if (sent < 0 && errno == EINTR) continue;
-      if (send_limit_.allow(steady_ns(), suppressed))
+      if (send_limit_.allow(host::monotonic_ns(), suppressed))
         log::warn("LCM {}: sending '{}' ({} B): {}{}", url_, channel, bytes.size(), std::strerror(errno),
                   suppressed > 0 ? " (" + std::to_string(suppressed) + " similar suppressed)" : std::string());
       return;

@@ -142,7 +142,7 @@ void UdpmReceiver::read(const OnMessage& on_message) {
     std::uint64_t suppressed = 0;
     if (got < 0) {
       if (errno == EINTR) continue;
-      if (errno != EAGAIN && errno != EWOULDBLOCK && warn_limit_.allow(steady_ns(), suppressed))
+      if (errno != EAGAIN && errno != EWOULDBLOCK && warn_limit_.allow(host::monotonic_ns(), suppressed))
         log::warn("LCM {}: receiving: {}", url_, errno_text());
       return;  // nothing more queued (or the next poll says again)
     }
@@ -152,7 +152,8 @@ void UdpmReceiver::read(const OnMessage& on_message) {
         sender, std::span<const std::uint8_t>(buffer_.data(), static_cast<std::size_t>(got)), message);
     if (verdict == udpm::Reassembler::Verdict::kMessage) {
       on_message(message.channel, message.payload);
-    } else if (verdict == udpm::Reassembler::Verdict::kMalformed && warn_limit_.allow(steady_ns(), suppressed)) {
+    } else if (verdict == udpm::Reassembler::Verdict::kMalformed &&
+               warn_limit_.allow(host::monotonic_ns(), suppressed)) {
       log::warn("LCM {}: a {} B datagram from {} is not an LCM message or fragment ({} malformed so far)", url_, got,
                 to_string(from), reassembler_.counters().malformed);
     }

@@ -1,6 +1,7 @@
 #include "trajroi/roi/transform.hpp"
 
 #include <cassert>
+#include <cstring>
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 #endif
@@ -77,9 +78,68 @@ __attribute__((target("avx"))) void transform_avx(const Eigen::Isometry3d& targe
     _mm_storeu_ps(&out[i].x, _mm_blend_ps(_mm256_cvtpd_ps(v), p, 0x8));  // intensity as it was
   }
 }
+
+// Row i of target_from_source applied to four points: ((r_i0 x + r_i1 y) + r_i2 z) + t_i.
+__attribute__((target("avx"))) inline __m128 transformed_row(const Eigen::Isometry3d& target_from_source,
+                                                             Eigen::Index i, __m256d x, __m256d y, __m256d z) noexcept {
+  const Eigen::Matrix3d& r = target_from_source.linear();
+  const __m256d sum =
+      _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(r(i, 0)), x), _mm256_mul_pd(_mm256_set1_pd(r(i, 1)), y));
+  return _mm256_cvtpd_ps(_mm256_add_pd(_mm256_add_pd(sum, _mm256_mul_pd(_mm256_set1_pd(r(i, 2)), z)),
+                                       _mm256_set1_pd(target_from_source.translation()(i))));
+}
+
+// Four records at a time: their x, y and z side by side (a transpose of the records' first 16
+// bytes), each coordinate's products and sums in the scalar order, in doubles, without fused
+// multiply-adds (none in this target). Places the whole fours and answers how many.
+__attribute__((target("avx"))) std::size_t transform_records_avx(const Eigen::Isometry3d& target_from_source,
+                                                                 const std::byte* records, std::size_t count,
+                                                                 RecordLayout layout, PointXYZI* out) noexcept {
+  const std::size_t stride = layout.stride_bytes;
+  const auto intensity = [&](std::size_t k) { return static_cast<int>(records[k * stride + layout.intensity_offset]); };
+  std::size_t i = 0;
+  for (; i + 4 <= count; i += 4, out += 4) {
+    const std::byte* p = records + i * stride;
+    __m128 a = _mm_loadu_ps(reinterpret_cast<const float*>(p));  // x y z (and 4 bytes more)
+    __m128 b = _mm_loadu_ps(reinterpret_cast<const float*>(p + stride));
+    __m128 c = _mm_loadu_ps(reinterpret_cast<const float*>(p + 2 * stride));
+    __m128 d = _mm_loadu_ps(reinterpret_cast<const float*>(p + 3 * stride));
+    _MM_TRANSPOSE4_PS(a, b, c, d);  // a: four x, b: four y, c: four z
+    const __m256d x = _mm256_cvtps_pd(a);
+    const __m256d y = _mm256_cvtps_pd(b);
+    const __m256d z = _mm256_cvtps_pd(c);
+    __m128 gx = transformed_row(target_from_source, 0, x, y, z);
+    __m128 gy = transformed_row(target_from_source, 1, x, y, z);
+    __m128 gz = transformed_row(target_from_source, 2, x, y, z);
+    __m128 gi = _mm_cvtepi32_ps(_mm_setr_epi32(intensity(i), intensity(i + 1), intensity(i + 2), intensity(i + 3)));
+    _MM_TRANSPOSE4_PS(gx, gy, gz, gi);
+    _mm_storeu_ps(&out[0].x, gx);
+    _mm_storeu_ps(&out[1].x, gy);
+    _mm_storeu_ps(&out[2].x, gz);
+    _mm_storeu_ps(&out[3].x, gi);
+  }
+  return i;
+}
 #endif
 
 }  // namespace
+
+void transform_records(const Eigen::Isometry3d& target_from_source, const std::byte* records, std::size_t count,
+                       RecordLayout layout, PointXYZI* out) {
+  assert(layout.stride_bytes >= 16 && layout.intensity_offset < layout.stride_bytes);
+  std::size_t done = 0;
+#if defined(__x86_64__) || defined(__i386__)
+  if (__builtin_cpu_supports("avx")) done = transform_records_avx(target_from_source, records, count, layout, out);
+#endif
+  for (std::size_t i = done; i < count; ++i) {
+    const std::byte* p = records + i * layout.stride_bytes;
+    PointXYZI& o = out[i];
+    std::memcpy(&o.x, p, 3 * sizeof(float));
+    o.intensity = static_cast<float>(static_cast<std::uint8_t>(p[layout.intensity_offset]));
+  }
+  const std::span<PointXYZI> rest(out + done, count - done);
+  transform_impl<PointXYZI>(target_from_source, rest, rest);
+}
 
 void transform_points(const Eigen::Isometry3d& target_from_source, std::span<const PointXYZI> in,
                       std::span<PointXYZI> out) {

@@ -24,11 +24,11 @@
 #include "outlet.hpp"
 #include "reload.hpp"
 #include "trajroi/daemon/config.hpp"
-#include "trajroi/daemon/sweep_processor.hpp"
 #include "trajroi/eval/scenario_eval.hpp"
 #include "trajroi/inputs/pacer.hpp"
 #include "trajroi/inputs/recorded_input.hpp"
 #include "trajroi/inputs/run_merger.hpp"
+#include "trajroi/pipeline/sweep_processor.hpp"
 #include "trajroi/points_t.hpp"
 #include "trajroi/status_t.hpp"
 #include "trajroid.hpp"
@@ -38,7 +38,7 @@ namespace {
 using namespace daemon_test;
 using trajroi::daemon::DaemonConfig;
 using trajroi::daemon::Pipeline;
-using trajroi::daemon::SweepProcessor;
+using trajroi::pipeline::SweepProcessor;
 namespace inputs = trajroi::inputs;
 
 struct Item {
@@ -132,26 +132,16 @@ Message decode(const std::vector<std::uint8_t>& bytes) {
 
 // The sweeps SweepProcessor makes from the run by itself, in the daemon's order.
 std::map<std::int64_t, std::size_t> reference_kept(const DaemonConfig& config) {
-  struct Count final : trajroi::daemon::SweepSink {
+  struct Count final : trajroi::pipeline::SweepSink {
     std::map<std::int64_t, std::size_t> kept;
-    void on_sweep(trajroi::daemon::Sweep& s) override {
+    void on_sweep(trajroi::pipeline::Sweep& s) override {
       if (s.filtered) kept[static_cast<std::int64_t>(s.index)] = s.size();
     }
   } sink;
-  SweepProcessor processor(config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
+  trajroi::pipeline::SweepProcessor processor(
+      config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
   for (const Item& i : run_items({})) {
-    switch (i.stream) {
-      case inputs::Stream::kGnss:
-        processor.gnss_bytes(i.bytes, i.t_ns);
-        break;
-      case inputs::Stream::kImu:
-        processor.imu_bytes(i.bytes, i.t_ns);
-        break;
-      default:
-        processor.lidar_datagram(i.stream == inputs::Stream::kLidarData ? trajroi::daemon::LidarPort::kData
-                                                                        : trajroi::daemon::LidarPort::kPosition,
-                                 i.bytes, i.t_ns, sink);
-    }
+    processor.process({i.stream, i.bytes, i.t_ns}, sink);
   }
   processor.flush(sink);
   return sink.kept;
@@ -168,7 +158,8 @@ TEST(Pipeline, ThreeFakeInputLanesThroughTheThreadsGiveTheProcessorsOwnSweeps) {
   pipeline.add_input(std::make_unique<FakeInput>(run_items({true, false, false}), kRate), 64, "test-lidar", {});
   pipeline.add_input(std::make_unique<FakeInput>(run_items({false, true, false}), kRate), 64, "test-gnss", {});
   pipeline.add_input(std::make_unique<FakeInput>(run_items({false, false, true}), kRate), 64, "test-imu", {});
-  SweepProcessor processor(config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
+  trajroi::pipeline::SweepProcessor processor(
+      config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
   FakeOutlet outlet;
   trajroi::daemon::RunOptions options;
   options.replay = corridor_run();  // said in the status message only
@@ -241,7 +232,7 @@ TEST(Pipeline, SweepsAndTheDecodeAheadRingAreResidentFromTheStart) {
     ++packets;
   EXPECT_EQ(packets, lidar.decoded->capacity());
   std::size_t sweeps = 0;
-  while (pipeline.sweeps.try_push([&](trajroi::daemon::Sweep& s) {
+  while (pipeline.sweeps.push([&](trajroi::pipeline::Sweep& s) {
     EXPECT_EQ(s.size(), 0U);
     EXPECT_GE(s.x.capacity(), config.buffers.max_points_per_sweep);
     const bool all = resident_capacity(s.x) && resident_capacity(s.y) && resident_capacity(s.z) &&
@@ -258,7 +249,8 @@ TEST(Pipeline, OneRecordedLaneIsExactlyTheProcessorsOutput) {
   Pipeline pipeline(config, /*exact=*/true, /*record=*/false);
   const std::vector<Item> items = run_items({});
   pipeline.add_input(std::make_unique<FakeInput>(items), 16, "test-replay", {});
-  SweepProcessor processor(config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
+  trajroi::pipeline::SweepProcessor processor(
+      config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
   FakeOutlet outlet;
   EXPECT_EQ(trajroi::daemon::run_pipeline(pipeline, processor, outlet, {}, /*signals=*/false), 0);
   std::map<std::int64_t, std::size_t> published;
@@ -287,8 +279,8 @@ TEST(Pipeline, TheEvaluationKeepsExactlyWhatTheDaemonPublishes) {
   Pipeline pipeline(daemon_config, /*exact=*/true, /*record=*/false);
   pipeline.add_input(std::make_unique<inputs::RecordedInput>(corridor_run(), inputs::RecordedOptions{}),
                      daemon_config.buffers.lidar_packets, "test-replay", {});
-  SweepProcessor processor(daemon_config,
-                           trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(daemon_config)));
+  trajroi::pipeline::SweepProcessor processor(
+      daemon_config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(daemon_config)));
   FakeOutlet outlet;
   ASSERT_EQ(trajroi::daemon::run_pipeline(pipeline, processor, outlet, {}, /*signals=*/false), 0);
   std::map<std::int64_t, trajroi::points_t> published;
@@ -302,8 +294,8 @@ TEST(Pipeline, TheEvaluationKeepsExactlyWhatTheDaemonPublishes) {
                                                static_cast<int>(std::lround(daemon_config.roi.spacing_ratio * 100.0)),
                                                daemon_config.pose_mode);
   struct Collect final : trajroi::eval::PipelineObserver {
-    std::map<std::int64_t, trajroi::daemon::Sweep> sweeps;
-    void on_sweep(std::size_t, const trajroi::daemon::Sweep& s, double) override {
+    std::map<std::int64_t, trajroi::pipeline::Sweep> sweeps;
+    void on_sweep(std::size_t, const trajroi::pipeline::Sweep& s, double) override {
       if (s.filtered) sweeps[static_cast<std::int64_t>(s.index)] = s;
     }
   } collect;
@@ -315,7 +307,7 @@ TEST(Pipeline, TheEvaluationKeepsExactlyWhatTheDaemonPublishes) {
   for (const auto& [index, m] : published) {
     const auto it = collect.sweeps.find(index);
     ASSERT_NE(it, collect.sweeps.end()) << "sweep " << index;
-    const trajroi::daemon::Sweep& s = it->second;
+    const trajroi::pipeline::Sweep& s = it->second;
     ASSERT_EQ(static_cast<std::size_t>(m.num_points), s.size()) << "sweep " << index;
     for (std::size_t i = 0; i < s.size(); ++i) {
       ASSERT_EQ(m.x[i], s.x[i]) << "sweep " << index << " point " << i;
@@ -340,7 +332,8 @@ TEST(Pipeline, LateSweepsAreCounted) {
   std::erase_if(items, [end_ns](const Item& i) { return i.t_ns > end_ns; });
   Pipeline pipeline(config, /*exact=*/false, /*record=*/false);
   pipeline.add_input(std::make_unique<FakeInput>(std::move(items), 2.0), config.buffers.lidar_packets, "test-run", {});
-  SweepProcessor processor(config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
+  trajroi::pipeline::SweepProcessor processor(
+      config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
   trajroi::daemon::RunOptions options;
   options.replay = corridor_run();
   // The daemon's log lines, kept for reading back.

@@ -19,10 +19,10 @@ std::vector<T> plain(const std::vector<T, Allocator>& v) {
 }
 
 using trajroi::daemon::PoseMode;
-using trajroi::daemon::Sweep;
+using trajroi::pipeline::Sweep;
 
-Sweep sweep_with(std::size_t n) {
-  Sweep s;
+trajroi::pipeline::Sweep sweep_with(std::size_t n) {
+  trajroi::pipeline::Sweep s;
   s.index = 41;
   s.start_ns = 1'700'000'000'123'456'789;
   s.end_ns = s.start_ns + 199'000'000;
@@ -53,7 +53,7 @@ Sweep sweep_with(std::size_t n) {
   return s;
 }
 
-std::vector<std::uint8_t> reference_bytes(const Sweep& s, PoseMode mode) {
+std::vector<std::uint8_t> reference_bytes(const trajroi::pipeline::Sweep& s, PoseMode mode) {
   trajroi::points_t m;
   trajroi::daemon::fill_points(s, mode, m);
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
@@ -69,7 +69,7 @@ TEST(PointsMessage, TheDirectEncoderWritesLcmsBytes) {
   for (const std::size_t n : {std::size_t{1000}, std::size_t{0}, std::size_t{1}, std::size_t{15}, std::size_t{17},
                               std::size_t{33}, std::size_t{57'600}, std::size_t{3}}) {
     for (const PoseMode mode : {PoseMode::kPerFiring, PoseMode::kPerSweep}) {
-      const Sweep s = sweep_with(n);
+      const trajroi::pipeline::Sweep s = sweep_with(n);
       trajroi::daemon::encode_points(s, mode, head, bytes);
       ASSERT_EQ(bytes, reference_bytes(s, mode)) << n << " points";
     }
@@ -77,7 +77,7 @@ TEST(PointsMessage, TheDirectEncoderWritesLcmsBytes) {
 }
 
 TEST(PointsMessage, TheBytesDecodeToTheSweep) {
-  const Sweep s = sweep_with(101);
+  const trajroi::pipeline::Sweep s = sweep_with(101);
   trajroi::points_t head;
   std::vector<std::uint8_t> bytes;
   trajroi::daemon::encode_points(s, PoseMode::kPerFiring, head, bytes);

@@ -19,6 +19,7 @@
 #include "daemon_fixture.hpp"
 #include "filter_check.hpp"
 #include "test_data.hpp"
+#include "trajroi/host/clock.hpp"
 #include "trajroi/inputs/input_source.hpp"
 #include "trajroi/pose/geodetic.hpp"
 #include "trajroi/pose_input_t.hpp"
@@ -165,7 +166,7 @@ TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKee
       m.orientation[3] = q.z();
       m.valid = true;
       while (!stop_localization) {
-        m.t_ns = trajroi::inputs::realtime_ns();
+        m.t_ns = trajroi::host::realtime_ns();
         lcm.publish(rig.prefix + "_POSE_INPUT", &m);
         std::this_thread::sleep_for(milliseconds(50));
       }

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "trajroi/host/clock.hpp"
 #include "trajroi/inputs/live_input.hpp"
 #include "trajroi/inputs/pacer.hpp"
 #include "trajroi/inputs/recorded_input.hpp"
@@ -138,17 +139,17 @@ TEST(Pacer, PlaysRecordedTimesAtTheRateAndAsFastAsPossibleAtZero) {
   Pacer fast(0.0);
   EXPECT_FALSE(fast.paced());
   const std::int64_t due = fast.due_ns(1'000'000'000'000);
-  EXPECT_LE(due, monotonic_ns()) << "not paced: every item is due now";
+  EXPECT_LE(due, trajroi::host::monotonic_ns()) << "not paced: every item is due now";
   Pacer twice(2.0);
-  const std::int64_t start = monotonic_ns();
+  const std::int64_t start = trajroi::host::monotonic_ns();
   EXPECT_TRUE(Pacer::sleep_until(twice.due_ns(5'000'000'000)));                // anchors: due now
   EXPECT_TRUE(Pacer::sleep_until(twice.due_ns(5'000'000'000 + 200'000'000)));  // 200 ms at 2x
-  const std::int64_t elapsed = monotonic_ns() - start;
+  const std::int64_t elapsed = trajroi::host::monotonic_ns() - start;
   EXPECT_GE(elapsed, 100'000'000);
   EXPECT_LT(elapsed, 600'000'000);
   // A stop flag ends the wait early.
   std::atomic<bool> stop{true};
-  EXPECT_FALSE(Pacer::sleep_until(monotonic_ns() + 10'000'000'000, &stop));
+  EXPECT_FALSE(Pacer::sleep_until(trajroi::host::monotonic_ns() + 10'000'000'000, &stop));
 }
 
 TEST(RecordedInput, PacedAtTheRecordedRateTakesTheRecordingsTime) {
@@ -158,13 +159,13 @@ TEST(RecordedInput, PacedAtTheRecordedRateTakesTheRecordingsTime) {
   options.rate = 1.0;
   RecordedInput input(run.dir, options);
   InputItem item;
-  const std::int64_t start = monotonic_ns();
+  const std::int64_t start = trajroi::host::monotonic_ns();
   std::size_t n = 0;
   for (int i = 0; i < 1000 && n < 7; ++i)
     n += input.next(item, 5ms) == InputSource::Next::kItem ? 1U : 0U;
   EXPECT_EQ(n, 7u);
   // 40 ms of recording at real time (items leave at most one 2 ms quantum early).
-  EXPECT_GE(monotonic_ns() - start, 38'000'000);
+  EXPECT_GE(trajroi::host::monotonic_ns() - start, 38'000'000);
   EXPECT_EQ(input.next(item, 5ms), InputSource::Next::kEnd);
 }
 
@@ -191,7 +192,7 @@ TEST(UdpInput, DatagramsComeOutStampedInTheMonotonicClockByPort) {
   for (int i = 0; i < 50 && data + position < 2; ++i) {
     const auto next = input.next(item, 100ms);
     if (next != InputSource::Next::kItem) continue;
-    const std::int64_t age = monotonic_ns() - item.receive_ns;
+    const std::int64_t age = trajroi::host::monotonic_ns() - item.receive_ns;
     EXPECT_GE(age, 0) << "a CLOCK_MONOTONIC stamp, not CLOCK_REALTIME";
     EXPECT_LT(age, 2'000'000'000);
     (item.stream == Stream::kLidarData ? data : position) += 1;
@@ -223,7 +224,7 @@ TEST(SerialInput, SaysWhenThePortOpensThenHandsItsBytes) {
     } else if (next == InputSource::Next::kItem) {
       EXPECT_TRUE(opened) << "the opening is said before the first bytes";
       EXPECT_EQ(item.stream, Stream::kGnss);
-      EXPECT_LE(item.receive_ns, monotonic_ns());
+      EXPECT_LE(item.receive_ns, trajroi::host::monotonic_ns());
       received += item.bytes.size();
     }
   }

@@ -1,7 +1,7 @@
 // SweepProcessor driven in process with the test scenario's recordings, merged by receive
 // time as trajroid's replay merges them: the speed growth of the ROI, the trajectory swap at
 // a sweep boundary, the pose gate without GNSS.
-#include "trajroi/daemon/sweep_processor.hpp"
+#include "trajroi/pipeline/sweep_processor.hpp"
 
 #include <gtest/gtest.h>
 
@@ -17,17 +17,19 @@
 namespace {
 
 using namespace daemon_test;
-using trajroi::daemon::ActiveTrajectory;
 using trajroi::daemon::DaemonConfig;
-using trajroi::daemon::LidarPort;
-using trajroi::daemon::Sweep;
-using trajroi::daemon::SweepProcessor;
+using trajroi::pipeline::ActiveTrajectory;
+using trajroi::pipeline::Sweep;
+using trajroi::pipeline::SweepProcessor;
 
 struct Event {
   enum Kind { kLidar, kGnss, kImu } kind;
-  LidarPort port = LidarPort::kData;
+  trajroi::inputs::Stream stream = trajroi::inputs::Stream::kLidarData;
   std::int64_t t_ns = 0;
   std::vector<std::uint8_t> bytes;
+  [[nodiscard]] trajroi::inputs::InputItem item(std::int64_t shift_ns = 0) const {
+    return {stream, bytes, t_ns + shift_ns};
+  }
 };
 
 // Every input of the run, in receive-time order (the daemon's own merger).
@@ -41,8 +43,8 @@ const std::vector<Event>& run_events() {
       const Event::Kind kind = item.stream == Stream::kGnss  ? Event::kGnss
                                : item.stream == Stream::kImu ? Event::kImu
                                                              : Event::kLidar;
-      out.push_back({kind, item.stream == Stream::kLidarPosition ? LidarPort::kPosition : LidarPort::kData,
-                     item.receive_ns, std::vector<std::uint8_t>(item.bytes.begin(), item.bytes.end())});
+      out.push_back(
+          {kind, item.stream, item.receive_ns, std::vector<std::uint8_t>(item.bytes.begin(), item.bytes.end())});
     }
     return out;
   }();
@@ -53,43 +55,43 @@ DaemonConfig run_config() {
   return trajroi::daemon::load_daemon_config(corridor_run() / "trajroid.yaml");
 }
 
-std::unique_ptr<ActiveTrajectory> trajectory_from(const fs::path& file, std::int32_t id) {
-  return std::make_unique<ActiveTrajectory>(
-      ActiveTrajectory{trajroi::roi::parse_trajectory_csv(slurp(file), file.string()), id});
+std::unique_ptr<trajroi::pipeline::ActiveTrajectory> trajectory_from(const fs::path& file, std::int32_t id) {
+  return std::make_unique<trajroi::pipeline::ActiveTrajectory>(
+      trajroi::pipeline::ActiveTrajectory{trajroi::roi::parse_trajectory_csv(slurp(file), file.string()), id});
 }
 
-struct Collect final : trajroi::daemon::SweepSink {
-  std::vector<Sweep> sweeps;
-  void on_sweep(Sweep& s) override { sweeps.push_back(s); }
+struct Collect final : trajroi::pipeline::SweepSink {
+  std::vector<trajroi::pipeline::Sweep> sweeps;
+  void on_sweep(trajroi::pipeline::Sweep& s) override { sweeps.push_back(s); }
 };
 
 // Feeds the run; `before_lidar(processor, sink)` runs before each lidar datagram. `with_gnss`
 // false leaves the GNSS stream out.
 template <typename Hook>
-Collect drive(SweepProcessor& processor, bool with_gnss, Hook before_lidar) {
+Collect drive(trajroi::pipeline::SweepProcessor& processor, bool with_gnss, Hook before_lidar) {
   Collect sink;
   for (const Event& e : run_events()) {
     if (e.kind == Event::kGnss) {
-      if (with_gnss) processor.gnss_bytes(e.bytes, e.t_ns);
+      if (with_gnss) processor.process(e.item(), sink);
     } else if (e.kind == Event::kImu) {
-      processor.imu_bytes(e.bytes, e.t_ns);
+      processor.process(e.item(), sink);
     } else {
       before_lidar(processor, sink);
-      processor.lidar_datagram(e.port, e.bytes, e.t_ns, sink);
+      processor.process(e.item(), sink);
     }
   }
   processor.flush(sink);
   return sink;
 }
 
-Collect drive(SweepProcessor& processor, bool with_gnss = true) {
-  return drive(processor, with_gnss, [](SweepProcessor&, Collect&) {});
+Collect drive(trajroi::pipeline::SweepProcessor& processor, bool with_gnss = true) {
+  return drive(processor, with_gnss, [](trajroi::pipeline::SweepProcessor&, Collect&) {});
 }
 
 // The publisher's ring takes a finished sweep's points by exchanging arrays: the header is
 // copied, every array's points move, the slot's old arrays (their capacity) go back.
 TEST(Sweep, TakeExchangesThePointArraysAndCopiesTheHeader) {
-  Sweep built, slot;
+  trajroi::pipeline::Sweep built, slot;
   built.reserve(64, 8);
   slot.reserve(64, 8);
   built.index = 41;
@@ -104,9 +106,9 @@ TEST(Sweep, TakeExchangesThePointArraysAndCopiesTheHeader) {
   built.return_type = {1, 3};
   built.time_offset_ns = {11, 12};
   built.point_index = {13, 14};
-  const Sweep expected = built;
+  const trajroi::pipeline::Sweep expected = built;
   // Where each of the seven point arrays lives.
-  const auto arrays = [](const Sweep& s) {
+  const auto arrays = [](const trajroi::pipeline::Sweep& s) {
     return std::vector<const void*>{s.x.data(),
                                     s.y.data(),
                                     s.z.data(),
@@ -145,25 +147,25 @@ TEST(SweepProcessor, TheRoiGrowsWithSpeedAndTheGrowthIsCapped) {
   config.roi.look_ahead_per_mps_s = 3.0;
   config.roi.width_per_mps_s = 2.0;
   config.roi.max_speed_mps = 5.0;
-  SweepProcessor grown(config, trajectory_from(config.trajectory_file, 0));
+  trajroi::pipeline::SweepProcessor grown(config, trajectory_from(config.trajectory_file, 0));
   const Collect free_run = drive(grown);
 
   DaemonConfig capped_config = config;
   capped_config.roi.max_speed_mps = 0.5;
-  SweepProcessor capped(capped_config, trajectory_from(config.trajectory_file, 0));
+  trajroi::pipeline::SweepProcessor capped(capped_config, trajectory_from(config.trajectory_file, 0));
   const Collect capped_run = drive(capped);
   ASSERT_EQ(free_run.sweeps.size(), capped_run.sweeps.size());
 
   const auto& r = config.roi;
   int cruising = 0, unknown = 0;
   for (std::size_t k = 0; k < free_run.sweeps.size(); ++k) {
-    const Sweep& s = free_run.sweeps[k];
+    const trajroi::pipeline::Sweep& s = free_run.sweeps[k];
     if (!s.filtered) continue;
     // The formula, sweep by sweep, with the speed the sweep reports.
     const double v = s.speed_known ? std::min(s.speed_mps, r.max_speed_mps) : r.max_speed_mps;
     EXPECT_DOUBLE_EQ(s.look_ahead_m, r.look_ahead_m + 3.0 * v) << k;
     EXPECT_DOUBLE_EQ(s.radius_m, (r.circle_diameter_m + 2.0 * v) / 2.0) << k;
-    const Sweep& c = capped_run.sweeps[k];
+    const trajroi::pipeline::Sweep& c = capped_run.sweeps[k];
     ASSERT_TRUE(c.filtered);
     ASSERT_EQ(c.speed_known, s.speed_known);
     const double vc = c.speed_known ? std::min(c.speed_mps, 0.5) : 0.5;
@@ -187,7 +189,7 @@ TEST(SweepProcessor, TheRoiGrowsWithSpeedAndTheGrowthIsCapped) {
 
 TEST(SweepProcessor, ATrajectoryOfferedInsideASweepTakesEffectAtTheNextOne) {
   const DaemonConfig config = run_config();
-  SweepProcessor processor(config, trajectory_from(config.trajectory_file, 0));
+  trajroi::pipeline::SweepProcessor processor(config, trajectory_from(config.trajectory_file, 0));
   // A path 1 m beside the configured one, offered in the middle of the 60th sweep.
   const fs::path shifted = fs::temp_directory_path() / ("shifted_" + std::to_string(::getpid()) + ".csv");
   {
@@ -201,7 +203,7 @@ TEST(SweepProcessor, ATrajectoryOfferedInsideASweepTakesEffectAtTheNextOne) {
   std::size_t datagrams_in_sweep = 0;
   std::uint64_t last_index = 0;
   bool offered = false;
-  const Collect run = drive(processor, true, [&](SweepProcessor& p, Collect& sink) {
+  const Collect run = drive(processor, true, [&](trajroi::pipeline::SweepProcessor& p, Collect& sink) {
     if (p.current().index != last_index) {
       last_index = p.current().index;
       datagrams_in_sweep = 0;
@@ -221,8 +223,8 @@ TEST(SweepProcessor, ATrajectoryOfferedInsideASweepTakesEffectAtTheNextOne) {
   EXPECT_EQ(processor.counters().trajectory_swaps, 1u);
   ASSERT_NE(processor.take_retired(), nullptr) << "the old trajectory is handed back, not freed in the loop";
   // The new chain lies on the new path: 1 m beside the old centres.
-  const Sweep& before = run.sweeps[offered_during];
-  const Sweep& after = run.sweeps[offered_during + 1];
+  const trajroi::pipeline::Sweep& before = run.sweeps[offered_during];
+  const trajroi::pipeline::Sweep& after = run.sweeps[offered_during + 1];
   ASSERT_TRUE(before.filtered && after.filtered);
   ASSERT_FALSE(before.centres.empty());
   ASSERT_FALSE(after.centres.empty());
@@ -233,10 +235,10 @@ TEST(SweepProcessor, ATrajectoryOfferedInsideASweepTakesEffectAtTheNextOne) {
 
 TEST(SweepProcessor, WithoutGnssNoSweepIsFilteredAndEachSaysWhy) {
   const DaemonConfig config = run_config();
-  SweepProcessor processor(config, trajectory_from(config.trajectory_file, 0));
+  trajroi::pipeline::SweepProcessor processor(config, trajectory_from(config.trajectory_file, 0));
   const Collect run = drive(processor, false);
   ASSERT_GT(run.sweeps.size(), 200u);
-  for (const Sweep& s : run.sweeps) {
+  for (const trajroi::pipeline::Sweep& s : run.sweeps) {
     EXPECT_FALSE(s.filtered);
     EXPECT_EQ(s.pose_status, trajroi::pose::PoseStatus::kNoGnss);
     EXPECT_EQ(s.size(), 0u) << "no point leaves without a pose";
@@ -257,17 +259,11 @@ namespace {
 TEST(SweepProcessor, APoseJumpBackAlongTheTrajectoryIsFoundAgain) {
   const auto& events = run_events();
   const std::int64_t lap_ns = events.back().t_ns - events.front().t_ns + 100'000'000;
-  SweepProcessor processor(run_config(), trajectory_from(corridor_run() / "trajectory.csv", 0));
+  trajroi::pipeline::SweepProcessor processor(run_config(), trajectory_from(corridor_run() / "trajectory.csv", 0));
   Collect sink;
   for (const std::int64_t shift : {std::int64_t{0}, lap_ns}) {
     for (const Event& e : events) {
-      if (e.kind == Event::kGnss) {
-        processor.gnss_bytes(e.bytes, e.t_ns + shift);
-      } else if (e.kind == Event::kImu) {
-        processor.imu_bytes(e.bytes, e.t_ns + shift);
-      } else {
-        processor.lidar_datagram(e.port, e.bytes, e.t_ns + shift, sink);
-      }
+      processor.process(e.item(shift), sink);
     }
   }
   processor.flush(sink);
@@ -276,12 +272,12 @@ TEST(SweepProcessor, APoseJumpBackAlongTheTrajectoryIsFoundAgain) {
   // Sweeps of the second pass against the first, matched by start time within the lap: the
   // same place on the trajectory (the first sweeps after the jump aside, whose speed and
   // attitude history still spans it).
-  std::map<std::int64_t, const Sweep*> first;
-  for (const Sweep& s : sink.sweeps) {
+  std::map<std::int64_t, const trajroi::pipeline::Sweep*> first;
+  for (const trajroi::pipeline::Sweep& s : sink.sweeps) {
     if (s.filtered && s.start_ns < events.front().t_ns + lap_ns) first[s.start_ns / 10'000'000] = &s;
   }
   std::size_t compared = 0;
-  for (const Sweep& s : sink.sweeps) {
+  for (const trajroi::pipeline::Sweep& s : sink.sweeps) {
     if (!s.filtered || s.start_ns < events.front().t_ns + lap_ns + 2'000'000'000) continue;
     const auto a = first.find((s.start_ns - lap_ns) / 10'000'000);
     if (a == first.end()) continue;

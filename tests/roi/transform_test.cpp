@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <numbers>
 #include <random>
@@ -47,6 +49,40 @@ TEST(Transform, EveryPathGivesTheScalarBits) {
     transform_points_scalar(pose, in, scalar);
     // (memcmp on no points would be handed the empty vectors' null data.)
     ASSERT_TRUE(n == 0 || std::memcmp(fast.data(), scalar.data(), n * sizeof(PointXYZI)) == 0) << n << " points";
+  }
+}
+
+// A decoder's record: x, y, z first, other fields, an 8-bit intensity further on (the layout
+// of vlp16::Point, 28 bytes).
+struct Record {
+  float x, y, z;
+  float distance_m, azimuth_deg;
+  std::uint32_t time_offset_ns;
+  std::uint8_t intensity, laser, ring, return_type;
+};
+
+// Placing records straight from the decoder's array gives the bits of copying them into
+// PointXYZI and transforming those with the scalar code: every count (the fours and the rest),
+// a far-from-origin tilted pose, and every intensity from 0 to 255.
+TEST(Transform, RecordsGiveTheBitsOfTheCopiedPoints) {
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<float> coordinate(-120.0f, 120.0f);
+  std::uniform_real_distribution<double> angle(-std::numbers::pi, std::numbers::pi);
+  for (const std::size_t n : {std::size_t{1}, std::size_t{3}, std::size_t{4}, std::size_t{5}, std::size_t{1023}}) {
+    const Eigen::Isometry3d pose =
+        pose_from_xyz_rpy(Eigen::Vector3d(-5321.5, 4987.25, 3.5), 0.1 * angle(rng), 0.1 * angle(rng), angle(rng));
+    std::vector<Record> records(n);
+    std::vector<PointXYZI> copied(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      records[i] = {coordinate(rng), coordinate(rng), 0.1f * coordinate(rng), 1.0f, 2.0f, 3, 0, 4, 5, 6};
+      records[i].intensity = static_cast<std::uint8_t>(i % 256);
+      copied[i] = {records[i].x, records[i].y, records[i].z, static_cast<float>(records[i].intensity)};
+    }
+    std::vector<PointXYZI> placed(n), scalar(n);
+    transform_records(pose, std::span<const Record>(records), placed.data());
+    transform_points_scalar(pose, copied, scalar);
+    ASSERT_EQ(std::memcmp(placed.data(), scalar.data(), n * sizeof(PointXYZI)), 0) << n << " records";
+    EXPECT_EQ(placed[n - 1].intensity, static_cast<float>((n - 1) % 256));
   }
 }
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "test_data.hpp"
+#include "trajroi/host/clock.hpp"
 #include "trajroi/serial/byte_log.hpp"
 #include "trajroi/serial/serial_port_source.hpp"
 #include "trajroi/ublox/config.hpp"
@@ -107,7 +108,7 @@ TEST(SerialPort, ReadsWhatTheDeviceSendsWithMonotonicStamps) {
     }
   });
   std::vector<std::int64_t> stamps;
-  const std::int64_t before = monotonic_now_ns();
+  const std::int64_t before = trajroi::host::monotonic_ns();
   const Bytes got = read_bytes(source, sent.size(), 5s, &stamps);
   writer.join();
   EXPECT_EQ(got, sent);

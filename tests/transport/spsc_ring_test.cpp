@@ -9,8 +9,12 @@
 #include <cstdint>
 #include <thread>
 
+#include "trajroi/transport/ring_lane.hpp"
+
 namespace {
 
+using trajroi::transport::FullRing;
+using trajroi::transport::RingLane;
 using trajroi::transport::SpscRing;
 
 TEST(SpscRing, HoldsItsCapacityInOrderAndCountsWhatDidNotFit) {
@@ -87,7 +91,9 @@ TEST(SpscRing, AWaitingPushGivesUpWhenStoppedAndCountsTheDrop) {
   EXPECT_FALSE(pushed);
   EXPECT_EQ(waits, 3);
   EXPECT_EQ(ring.dropped(), 1u);
-  EXPECT_EQ(*ring.front(), 1);
+  const int* oldest = ring.front();
+  ASSERT_NE(oldest, nullptr);
+  EXPECT_EQ(*oldest, 1);
 }
 
 TEST(SpscRing, AProducerThatNeverWaitsDropsTheNewestAndCountsEveryOne) {
@@ -113,6 +119,60 @@ TEST(SpscRing, AProducerThatNeverWaitsDropsTheNewestAndCountsEveryOne) {
   producer.join();
   EXPECT_TRUE(increasing);
   EXPECT_EQ(received + ring.dropped(), kItems);
+}
+
+// A lossy lane drops the newest item of a full ring and counts it under the item's kind;
+// nothing it already holds is touched.
+TEST(SpscRing, ALossyLaneCountsItsDropsByKind) {
+  const std::atomic<bool> stop{false};
+  RingLane<int, 3> lane(4, FullRing::kDrop, stop, [] { FAIL() << "a lossy lane never waits"; });
+  for (int i = 0; i < 4; ++i)
+    ASSERT_TRUE(lane.push([i](int& slot) { slot = i; }, 0));
+  EXPECT_FALSE(lane.push([](int& slot) { slot = 90; }, 1));
+  EXPECT_FALSE(lane.push([](int& slot) { slot = 91; }, 2));
+  EXPECT_FALSE(lane.push([](int& slot) { slot = 92; }, 2));
+  EXPECT_EQ(lane.dropped(0), 0u);
+  EXPECT_EQ(lane.dropped(1), 1u);
+  EXPECT_EQ(lane.dropped(2), 2u);
+  EXPECT_EQ(lane.dropped(), 3u);
+  for (int i = 0; i < 4; ++i) {
+    const int* item = lane.front();
+    ASSERT_NE(item, nullptr);
+    EXPECT_EQ(*item, i);
+    lane.release();
+  }
+  EXPECT_EQ(lane.front(), nullptr);
+}
+
+// An exact lane waits on a full ring (its wait runs between tries) until the consumer makes
+// room: two threads pass every item, none dropped; once stopped, a full lane drops and counts.
+TEST(SpscRing, AnExactLaneLosesNothingAndGivesUpOnlyWhenStopped) {
+  std::atomic<bool> stop{false};
+  std::atomic<int> waits{0};
+  RingLane<int> lane(8, FullRing::kWait, stop, [&waits] {
+    waits.fetch_add(1, std::memory_order_relaxed);
+    std::this_thread::yield();
+  });
+  constexpr int kItems = 200'000;
+  std::thread consumer([&lane] {
+    for (int expected = 0; expected < kItems;) {
+      if (int* item = lane.front()) {
+        ASSERT_EQ(*item, expected);
+        ++expected;
+        lane.release();
+      }
+    }
+  });
+  for (int i = 0; i < kItems; ++i)
+    ASSERT_TRUE(lane.push([i](int& slot) { slot = i; }));
+  consumer.join();
+  EXPECT_EQ(lane.dropped(), 0u);
+  EXPECT_GT(waits.load(), 0) << "the producer outran an 8-slot ring at least once";
+  for (int i = 0; i < 8; ++i)
+    ASSERT_TRUE(lane.push([](int& slot) { slot = 0; }));
+  stop.store(true);
+  EXPECT_FALSE(lane.push([](int& slot) { slot = 1; }));
+  EXPECT_EQ(lane.dropped(), 1u);
 }
 
 }  // namespace

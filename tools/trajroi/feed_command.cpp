@@ -28,6 +28,7 @@
 
 #include "commands.hpp"
 #include "trajroi/framing/little_endian.hpp"
+#include "trajroi/host/clock.hpp"
 #include "trajroi/inputs/pacer.hpp"
 #include "trajroi/inputs/run_merger.hpp"
 #include "trajroi/ublox/framer.hpp"
@@ -143,7 +144,7 @@ class PtyDevice {
     std::error_code ignored;
     fs::remove(link_, ignored);
     fs::create_symlink(slave, link_);
-    appeared_ns_ = inputs::monotonic_ns();
+    appeared_ns_ = host::monotonic_ns();
     reopen_reported_ = false;
     std::printf("feed: %s device %s -> %s\n", name_.c_str(), link_.c_str(), slave);
     std::fflush(stdout);
@@ -160,7 +161,7 @@ class PtyDevice {
     if (reopen_reported_ || generation == 0 || !reader_open()) return;
     reopen_reported_ = true;
     std::printf("feed: %s reopened by the reader %.3f s after it reappeared\n", name_.c_str(),
-                static_cast<double>(inputs::monotonic_ns() - appeared_ns_) * 1e-9);
+                static_cast<double>(host::monotonic_ns() - appeared_ns_) * 1e-9);
     std::fflush(stdout);
   }
 
@@ -433,19 +434,19 @@ void run_feed(const FeedOptions& o) {
   if (!o.foreign_from.empty()) foreign = std::make_unique<UdpSender>(o.foreign_from);
 
   // The readers open their devices first (a daemon starting), then the clock starts.
-  const std::int64_t give_up = inputs::monotonic_ns() + static_cast<std::int64_t>(o.wait_for_readers_s * 1e9);
+  const std::int64_t give_up = host::monotonic_ns() + static_cast<std::int64_t>(o.wait_for_readers_s * 1e9);
   while ((gnss_dev && !gnss_dev->reader_open()) || (imu_dev && !imu_dev->reader_open())) {
-    if (inputs::monotonic_ns() > give_up) {
+    if (host::monotonic_ns() > give_up) {
       throw std::runtime_error("no reader opened the serial devices within --wait-for-readers");
     }
-    inputs::Pacer::sleep_until(inputs::monotonic_ns() + 10'000'000);
+    inputs::Pacer::sleep_until(host::monotonic_ns() + 10'000'000);
   }
 
   std::int64_t t0 = 0;
   if (merger ? !merger->peek_time(t0) : chunks.empty()) throw std::runtime_error("feed: nothing to feed");
   if (!merger) t0 = chunks.front().t_ns;
   inputs::Pacer pacer(o.rate);
-  const std::int64_t start = inputs::monotonic_ns();
+  const std::int64_t start = host::monotonic_ns();
   double data_s = 0.0;
   std::uint64_t flood_sent = 0, malformed_sent = 0, foreign_sent = 0, data_sent = 0;
   std::uint64_t serial_undelivered[2] = {0, 0};
@@ -516,13 +517,13 @@ void run_feed(const FeedOptions& o) {
   std::printf(
       "feed: done: %.3f s of data in %.3f s; UDP sent %llu (%llu data, %llu flood of which %llu malformed)"
       " from %s, %llu from %s; serial chunks with no reader: gnss %llu, imu %llu\n",
-      data_s, static_cast<double>(inputs::monotonic_ns() - start) * 1e-9,
-      static_cast<unsigned long long>(sensor.sent()), static_cast<unsigned long long>(data_sent),
-      static_cast<unsigned long long>(flood_sent), static_cast<unsigned long long>(malformed_sent), o.from.c_str(),
-      static_cast<unsigned long long>(foreign_sent), o.foreign_from.empty() ? "-" : o.foreign_from.c_str(),
-      static_cast<unsigned long long>(serial_undelivered[0]), static_cast<unsigned long long>(serial_undelivered[1]));
+      data_s, static_cast<double>(host::monotonic_ns() - start) * 1e-9, static_cast<unsigned long long>(sensor.sent()),
+      static_cast<unsigned long long>(data_sent), static_cast<unsigned long long>(flood_sent),
+      static_cast<unsigned long long>(malformed_sent), o.from.c_str(), static_cast<unsigned long long>(foreign_sent),
+      o.foreign_from.empty() ? "-" : o.foreign_from.c_str(), static_cast<unsigned long long>(serial_undelivered[0]),
+      static_cast<unsigned long long>(serial_undelivered[1]));
   std::fflush(stdout);
-  inputs::Pacer::sleep_until(inputs::monotonic_ns() + static_cast<std::int64_t>(o.linger_s * 1e9));
+  inputs::Pacer::sleep_until(host::monotonic_ns() + static_cast<std::int64_t>(o.linger_s * 1e9));
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 
 #include "commands.hpp"
 #include "trajroi/eval/steadiness.hpp"
+#include "trajroi/host/clock.hpp"
 #include "trajroi/inputs/input_source.hpp"
 #include "trajroi/inputs/pacer.hpp"
 #include "trajroi/roi/cpu.hpp"
@@ -45,9 +46,9 @@ long calibrate_steps(double piece_us) {
   double fastest_us = 1e30;
   double sink = 1.0;
   for (int i = 0; i < 50; ++i) {
-    const std::int64_t start = inputs::monotonic_ns();
+    const std::int64_t start = host::monotonic_ns();
     sink = arithmetic(kProbe, sink);
-    fastest_us = std::min(fastest_us, static_cast<double>(inputs::monotonic_ns() - start) * 1e-3);
+    fastest_us = std::min(fastest_us, static_cast<double>(host::monotonic_ns() - start) * 1e-3);
   }
   if (sink == 0.0) std::puts("");  // keeps the chain
   return std::max(1L, static_cast<long>(static_cast<double>(kProbe) * piece_us / std::max(fastest_us, 1e-3)));
@@ -70,14 +71,14 @@ void time_pieces(Timer& timer, const MachineOptions& o, long steps, std::int64_t
   timer.fifo = o.priority > 0 && pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
   const std::int64_t every_ns = std::llround(o.every_ms * 1e6);
   const std::int64_t end_ns = start_ns + std::llround(o.seconds * 1e9);
-  std::int64_t next_ns = inputs::monotonic_ns();
+  std::int64_t next_ns = host::monotonic_ns();
   double x = 1.0;
   timer.pieces.reserve(static_cast<std::size_t>(o.seconds * 1e3 / o.every_ms) + 16);
   for (;;) {
-    const std::int64_t t = inputs::monotonic_ns();
+    const std::int64_t t = host::monotonic_ns();
     if (t >= end_ns) break;
     x = arithmetic(steps, x);
-    const std::int64_t done = inputs::monotonic_ns();
+    const std::int64_t done = host::monotonic_ns();
     timer.pieces.push_back({static_cast<double>(t - start_ns) * 1e-9, static_cast<double>(done - t) * 1e-3});
     // The next piece one interval on; after a slow spell, one interval from now (catching up
     // would run pieces back to back, above every other thread).
@@ -102,7 +103,7 @@ int run_machine(const MachineOptions& o) {
     if (CPU_ISSET(cpu, &allowed)) timers.push_back({cpu, false, false, {}});
   }
   const long steps = calibrate_steps(o.piece_us);
-  const std::int64_t start_ns = inputs::monotonic_ns();
+  const std::int64_t start_ns = host::monotonic_ns();
   std::vector<std::thread> threads;
   threads.reserve(timers.size());
   for (Timer& t : timers)

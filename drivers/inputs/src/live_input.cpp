@@ -1,5 +1,7 @@
 #include "trajroi/inputs/live_input.hpp"
 
+#include "trajroi/host/clock.hpp"
+
 namespace trajroi::inputs {
 
 // ---- UDP ------------------------------------------------------------------------------------
@@ -46,7 +48,7 @@ UdpInput::Next UdpInput::next(InputItem& item, std::chrono::milliseconds timeout
     break;
   }
   // The kernel's stamp is CLOCK_REALTIME; the daemon's one time base is CLOCK_MONOTONIC.
-  item.receive_ns = d.receive_time_ns - (realtime_ns() - monotonic_ns());
+  item.receive_ns = d.receive_time_ns - (host::realtime_ns() - host::monotonic_ns());
   item.stream = d.destination_port == udp_->position_port() ? Stream::kLidarPosition : Stream::kLidarData;
   item.bytes = d.payload;
   ++items_;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "trajroi/host/clock.hpp"
+
 namespace trajroi::inputs {
 
 RecordedInput::RecordedInput(std::filesystem::path dir, RecordedOptions options)
@@ -50,7 +52,7 @@ RecordedInput::Next RecordedInput::next(InputItem& item, std::chrono::millisecon
   }
   if (pacer_.paced()) {
     const std::int64_t due = pacer_.due_ns(t);
-    const std::int64_t now = monotonic_ns();
+    const std::int64_t now = host::monotonic_ns();
     if (due > now + kPacingQuantum_ns) {
       ready_ = false;
       const std::int64_t until = std::min(due, now + std::chrono::nanoseconds(timeout).count());
@@ -62,7 +64,7 @@ RecordedInput::Next RecordedInput::next(InputItem& item, std::chrono::millisecon
   ++items_;
   std::int64_t following = 0;
   ready_ = merger_->peek_time(following) &&
-           (!pacer_.paced() || pacer_.due_ns(following) <= monotonic_ns() + kPacingQuantum_ns);
+           (!pacer_.paced() || pacer_.due_ns(following) <= host::monotonic_ns() + kPacingQuantum_ns);
   return Next::kItem;
 }
 

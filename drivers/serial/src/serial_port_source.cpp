@@ -14,6 +14,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "trajroi/host/clock.hpp"
+
 namespace trajroi::serial {
 
 namespace {
@@ -118,7 +120,7 @@ class SerialPortSource::TermiosPort final : public Port {
   }
   long write(const std::uint8_t* data, std::size_t size, unsigned timeout_ms) override {
     std::size_t done = 0;
-    const std::int64_t deadline = monotonic_now_ns() + static_cast<std::int64_t>(timeout_ms) * 1'000'000;
+    const std::int64_t deadline = host::monotonic_ns() + static_cast<std::int64_t>(timeout_ms) * 1'000'000;
     while (done < size) {
       const ssize_t n = ::write(fd_, data + done, size - done);
       if (n > 0) {
@@ -126,7 +128,7 @@ class SerialPortSource::TermiosPort final : public Port {
         continue;
       }
       if (n < 0 && errno != EAGAIN && errno != EINTR) return -1;
-      const std::int64_t left_ms = (deadline - monotonic_now_ns()) / 1'000'000;
+      const std::int64_t left_ms = (deadline - host::monotonic_ns()) / 1'000'000;
       if (left_ms <= 0) break;
       pollfd p{fd_, POLLOUT, 0};
       ::poll(&p, 1, static_cast<int>(left_ms));
@@ -211,7 +213,7 @@ bool SerialPortSource::try_open() {
     }
     last_error_ = options_.device + ": " + error;
     ++counters_.open_failures;
-    next_open_ns_ = monotonic_now_ns() + std::chrono::duration_cast<std::chrono::nanoseconds>(backoff_).count();
+    next_open_ns_ = host::monotonic_ns() + std::chrono::duration_cast<std::chrono::nanoseconds>(backoff_).count();
     backoff_ = std::min(backoff_ * 2, options_.max_backoff);
     return false;
   }
@@ -227,7 +229,7 @@ void SerialPortSource::close_port() {
 
 ReadStatus SerialPortSource::read(Chunk& chunk, std::chrono::milliseconds timeout) {
   if (!port_) {
-    const std::int64_t now = monotonic_now_ns();
+    const std::int64_t now = host::monotonic_ns();
     if (now < next_open_ns_) {
       const auto wait = std::min<std::int64_t>(next_open_ns_ - now,
                                                std::chrono::duration_cast<std::chrono::nanoseconds>(timeout).count());
@@ -240,7 +242,7 @@ ReadStatus SerialPortSource::read(Chunk& chunk, std::chrono::milliseconds timeou
   const long n = port_->read(buffer_.data(), buffer_.size(), timeout_ms);
   if (n > 0) {
     chunk.bytes = std::span<const std::uint8_t>(buffer_.data(), static_cast<std::size_t>(n));
-    chunk.receive_time_ns = monotonic_now_ns();
+    chunk.receive_time_ns = host::monotonic_ns();
     ++counters_.chunks;
     counters_.bytes += static_cast<std::uint64_t>(n);
     return ReadStatus::kData;
@@ -251,7 +253,7 @@ ReadStatus SerialPortSource::read(Chunk& chunk, std::chrono::milliseconds timeou
     last_error_ = options_.device + (n < 0 ? ": read failed (device gone)" : ": device node disappeared");
     close_port();
     ++counters_.disconnects;
-    next_open_ns_ = monotonic_now_ns() + std::chrono::duration_cast<std::chrono::nanoseconds>(backoff_).count();
+    next_open_ns_ = host::monotonic_ns() + std::chrono::duration_cast<std::chrono::nanoseconds>(backoff_).count();
     return ReadStatus::kDisconnected;
   }
   return ReadStatus::kTimeout;

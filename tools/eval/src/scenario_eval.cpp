@@ -9,9 +9,9 @@
 #include <stdexcept>
 
 #include "trajroi/config/text_file.hpp"
-#include "trajroi/daemon/sweep_processor.hpp"
 #include "trajroi/inputs/capture.hpp"
 #include "trajroi/inputs/run_merger.hpp"
+#include "trajroi/pipeline/sweep_processor.hpp"
 #include "trajroi/roi/grid_filter.hpp"
 #include "trajroi/roi/shapes.hpp"
 #include "trajroi/roi/transform.hpp"
@@ -37,23 +37,20 @@ void add_sample(TimingStats& t, std::size_t& n, double ms) {
 // ---- RoiChain -----------------------------------------------------------------------------
 
 RoiChain::RoiChain(const sim::EvaluationSpec& spec)
-    : spec_(spec), circles_(spec.circle_diameter_m / 2.0, {}), rects_(spec.rect_height_m, spec.rect_width_m, {}) {}
+    : spec_(spec),
+      circles_(RoiShape::kCircular, roi::ChainSize{spec.circle_diameter_m / 2.0, 0.0, 0.0}),
+      rects_(RoiShape::kRectangular, roi::ChainSize{0.0, spec.rect_height_m, spec.rect_width_m}) {}
 
 void RoiChain::run(const roi::Trajectory& trajectory, double s0_m, double look_ahead_m, RoiShape shape, int ratio_pct,
                    std::span<const roi::PointXYZI> points) {
   const bool circular = shape == RoiShape::kCircular;
+  roi::RoiChain& chain = circular ? circles_ : rects_;
   const double spacing =
       roi::spacing_from_ratio(ratio_pct / 100.0, circular ? spec_.circle_diameter_m : spec_.rect_height_m);
-  roi::place_centres(trajectory, s0_m, look_ahead_m, spacing, centres_);
-  if (circular) {
-    circles_.assign(centres_);
-    circle_grid_.build(circles_);
-    circle_grid_.filter(points, kept_);
-  } else {
-    rects_.assign(centres_);
-    rect_grid_.build(rects_);
-    rect_grid_.filter(points, kept_);
-  }
+  chain.place(trajectory, s0_m, look_ahead_m, spacing,
+              roi::ChainSize{spec_.circle_diameter_m / 2.0, spec_.rect_height_m, spec_.rect_width_m});
+  (void)chain.filter(points, kept_);
+  last_ = &chain;
 }
 
 // ---- ScenarioRun ---------------------------------------------------------------------------
@@ -73,7 +70,7 @@ ScenarioRun::ScenarioRun(const fs::path& dir) : dir_(dir) {
   // GNSS position).
   const std::size_t capacity = 1U << 20;
   poses_ = std::make_unique<pose::PoseBuffer>(config_.gate, config_.gnss_antenna_m, capacity);
-  pose_input::PoseInput input(pose::GlobalFrame::local_cartesian(config_.origin), daemon::pose_input_config(config_),
+  pose_input::PoseInput input(pose::GlobalFrame::local_cartesian(config_.origin), pipeline::pose_input_config(config_),
                               *poses_);
   inputs::RunMerger merger(dir, inputs::RunStreams{false, true, true});
   inputs::InputItem item;
@@ -92,11 +89,7 @@ ScenarioRun::ScenarioRun(const fs::path& dir) : dir_(dir) {
 ScenarioRun::~ScenarioRun() = default;
 
 vlp16::StreamOptions ScenarioRun::stream_options() const {
-  vlp16::StreamOptions o;
-  o.decode.min_range_m = config_.lidar.min_range_m;
-  o.decode.max_range_m = config_.lidar.max_range_m;
-  o.cut_azimuth_deg = config_.lidar.cut_azimuth_deg;
-  return o;
+  return pipeline::stream_options(config_);
 }
 
 daemon::DaemonConfig ScenarioRun::pipeline_config(RoiShape shape, int ratio_pct, daemon::PoseMode mode) const {
@@ -127,7 +120,7 @@ vlp16::StreamCounters ScenarioRun::for_each_frame(const FrameCallback& on_frame)
     }
   } sink;
   sink.callback = &on_frame;
-  vlp16::StreamDecoder decoder(vlp16::Calibration::vlp16_default(), stream_options());
+  vlp16::StreamDecoder decoder(pipeline::load_calibration(config_), stream_options());
   vlp16::PcapSource source(dir_ / sim::kLidarFile);
   inputs::CaptureDecoder capture(source, decoder);
   for (;;) {
@@ -147,15 +140,15 @@ vlp16::StreamCounters ScenarioRun::for_each_frame(const FrameCallback& on_frame)
 void run_pipelines(const ScenarioRun& run, std::span<const daemon::DaemonConfig> configs, PipelineObserver& observer,
                    std::int64_t until_ns) {
   // Per configuration: its processor, and a sink that times the packets of each sweep.
-  struct Lane final : daemon::SweepSink {
+  struct Lane final : pipeline::SweepSink {
     std::size_t index = 0;
     PipelineObserver* observer = nullptr;
-    std::unique_ptr<daemon::SweepProcessor> processor;
+    std::unique_ptr<pipeline::SweepProcessor> processor;
     double sweep_ms = 0.0;
     std::chrono::steady_clock::time_point packet_start;
     bool past_end = false;
     std::int64_t until_ns = 0;
-    void on_sweep(daemon::Sweep& sweep) override {
+    void on_sweep(pipeline::Sweep& sweep) override {
       sweep_ms += elapsed_ms(packet_start);
       observer->on_sweep(index, sweep, sweep_ms);
       sweep_ms = 0.0;
@@ -171,8 +164,8 @@ void run_pipelines(const ScenarioRun& run, std::span<const daemon::DaemonConfig>
     lanes[k].index = k;
     lanes[k].observer = &observer;
     lanes[k].until_ns = until_ns;
-    lanes[k].processor = std::make_unique<daemon::SweepProcessor>(
-        configs[k], std::make_unique<daemon::ActiveTrajectory>(daemon::ActiveTrajectory{run.trajectory(), 0}));
+    lanes[k].processor = std::make_unique<pipeline::SweepProcessor>(
+        configs[k], std::make_unique<pipeline::ActiveTrajectory>(pipeline::ActiveTrajectory{run.trajectory(), 0}));
     lanes[k].processor->keep_point_indices();
   }
   inputs::RunMerger merger(run.dir());
@@ -181,27 +174,14 @@ void run_pipelines(const ScenarioRun& run, std::span<const daemon::DaemonConfig>
   while (!all_past && merger.next(item)) {
     all_past = true;
     for (Lane& lane : lanes) {
-      daemon::SweepProcessor& p = *lane.processor;
-      switch (item.stream) {
-        case inputs::Stream::kGnss:
-          p.gnss_bytes(item.bytes, item.receive_ns);
-          break;
-        case inputs::Stream::kImu:
-          p.imu_bytes(item.bytes, item.receive_ns);
-          break;
-        case inputs::Stream::kPose:
-          p.pose_message(item.bytes, item.receive_ns);
-          break;
-        case inputs::Stream::kLidarData:
-        case inputs::Stream::kLidarPosition: {
-          lane.packet_start = std::chrono::steady_clock::now();
-          p.lidar_datagram(
-              item.stream == inputs::Stream::kLidarData ? daemon::LidarPort::kData : daemon::LidarPort::kPosition,
-              item.bytes, item.receive_ns, lane);
-          lane.sweep_ms += elapsed_ms(lane.packet_start);
-          lane.packet_start = std::chrono::steady_clock::now();
-          break;
-        }
+      pipeline::SweepProcessor& p = *lane.processor;
+      if (inputs::is_lidar(item.stream)) {
+        lane.packet_start = std::chrono::steady_clock::now();
+        p.process(item, lane);
+        lane.sweep_ms += elapsed_ms(lane.packet_start);
+        lane.packet_start = std::chrono::steady_clock::now();
+      } else {
+        p.process(item, lane);
       }
       all_past = all_past && lane.past_end;
     }
@@ -283,7 +263,7 @@ std::vector<KeyframeCase> keyframe_cases(const ScenarioRun& run, PoseMode mode) 
         std::copy(placed.begin(), placed.end(), c.points.begin() + static_cast<std::ptrdiff_t>(first));
       }
     }
-    void on_sweep(std::size_t, const daemon::Sweep& sweep, double) override {
+    void on_sweep(std::size_t, const pipeline::Sweep& sweep, double) override {
       for (std::size_t k = 0; k < cases->size(); ++k) {
         KeyframeCase& c = (*cases)[k];
         if (c.frame.start_time_ns != sweep.start_ns) continue;
@@ -341,7 +321,7 @@ std::vector<KeyframeRow> run_keyframe_rows(const ScenarioRun& run, const std::ve
     const std::vector<KeyframeCase>* cases;
     std::function<KeyframeRow&(std::size_t, std::size_t)> row;
     std::vector<std::size_t> samples;
-    void on_sweep(std::size_t k, const daemon::Sweep& sweep, double ms) override {
+    void on_sweep(std::size_t k, const pipeline::Sweep& sweep, double ms) override {
       for (std::size_t c = 0; c < cases->size(); ++c) {
         if ((*cases)[c].frame.start_time_ns != sweep.start_ns) continue;
         KeyframeRow& r = row(k, c);
@@ -396,7 +376,7 @@ SequentialReport run_sequential(const ScenarioRun& run, PoseMode mode, int ratio
     std::map<std::uint64_t, FrameTiming> frames;   // complete sweeps with a valid pose, by index
     std::map<std::uint64_t, std::int64_t> starts;  // every complete sweep's start (the data cycle)
     std::size_t n_circ = 0, n_rect = 0;
-    void on_sweep(std::size_t k, const daemon::Sweep& sweep, double ms) override {
+    void on_sweep(std::size_t k, const pipeline::Sweep& sweep, double ms) override {
       if (sweep.partial) {
         if (k == 0) ++report.skipped_partial;
         return;
@@ -493,7 +473,7 @@ AccumulatedReport run_accumulated(const ScenarioRun& run, PoseMode mode, int rat
       if (placed.size() < frame.points.size()) placed.reserve(frame.points.size());
       placed.insert(placed.end(), points.begin(), points.end());
     }
-    void on_sweep(std::size_t, const daemon::Sweep& sweep, double) override {
+    void on_sweep(std::size_t, const pipeline::Sweep& sweep, double) override {
       const bool whole = !sweep.partial && sweep.filtered && placed.size() == sweep.points_in;
       if (!whole) {
         placed.clear();

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "trajroi/daemon/config.hpp"
-#include "trajroi/daemon/sweep_processor.hpp"
+#include "trajroi/pipeline/sweep.hpp"
 #include "trajroi/points_t.hpp"
 #include "trajroi/pose/geodetic.hpp"
 #include "trajroi/pose_t.hpp"
@@ -20,17 +20,18 @@
 
 namespace trajroi::daemon {
 
-void fill_pose(const Sweep& sweep, trajroi::pose_t& out);
-void fill_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& out);
+void fill_pose(const pipeline::Sweep& sweep, trajroi::pose_t& out);
+void fill_points(const pipeline::Sweep& sweep, PoseMode mode, trajroi::points_t& out);
 // The sweep's points_t encoded (LCM's fingerprint and big-endian fields, the bytes
 // points_t::encode writes for fill_points' message) into `out`, resized to the size. The
 // arrays go from the sweep's vectors straight into the bytes: LCM's generated encoder swaps
 // them an element at a time. `head` is scratch for the fields before the arrays.
-void encode_points(const Sweep& sweep, PoseMode mode, trajroi::points_t& head, std::vector<std::uint8_t>& out);
+void encode_points(const pipeline::Sweep& sweep, PoseMode mode, trajroi::points_t& head,
+                   std::vector<std::uint8_t>& out);
 // The bytes a point takes in that encoding: x, y, z, time offset and one each of intensity,
 // ring and return type.
 inline constexpr std::size_t kEncodedBytesPerPoint = 4 * sizeof(std::uint32_t) + 3;
-void fill_roi(const Sweep& sweep, trajroi::roi_t& out);
+void fill_roi(const pipeline::Sweep& sweep, trajroi::roi_t& out);
 
 // Why an incoming trajectory was refused (counted by reason in status_t).
 enum class TrajectoryReject : std::uint8_t {
@@ -47,7 +48,7 @@ inline constexpr std::size_t kTrajectoryRejectCount = 8;
 [[nodiscard]] std::string_view to_string(TrajectoryReject reason) noexcept;
 
 struct TrajectoryCheck {
-  std::unique_ptr<ActiveTrajectory> trajectory;  // set when accepted
+  std::unique_ptr<pipeline::ActiveTrajectory> trajectory;  // set when accepted
   TrajectoryReject reason = TrajectoryReject::kNone;
   std::string detail;  // for the log
 };

@@ -11,7 +11,7 @@
 #include <string_view>
 
 #include "trajroi/daemon/config.hpp"
-#include "trajroi/daemon/sweep_processor.hpp"
+#include "trajroi/pipeline/sweep.hpp"
 
 namespace trajroi::daemon {
 
@@ -26,7 +26,7 @@ struct TrajectorySource {
 
 // Reads and checks. Throws (roi::TrajectoryError, std::runtime_error) naming the file, the
 // line and the value.
-[[nodiscard]] std::unique_ptr<ActiveTrajectory> load_trajectory(const TrajectorySource& source);
+[[nodiscard]] std::unique_ptr<pipeline::ActiveTrajectory> load_trajectory(const TrajectorySource& source);
 [[nodiscard]] roi::Trajectory parse_trajectory(std::string_view text, const TrajectorySource& source);
 
 }  // namespace trajroi::daemon

@@ -1,22 +1,22 @@
 #pragma once
 
-// The processing thread's work, without the thread: lidar datagrams and GNSS / IMU bytes in
-// (each with its host receive time), filtered sweeps out. Pure and deterministic: the same
-// inputs in the same order give the same sweeps, which is what makes a replay exact and what
-// the tests drive directly.
+// The per-sweep pipeline, without a thread: input items in (LiDAR datagrams, GNSS and IMU
+// bytes, localization messages, each with its host receive time), filtered sweeps out. Pure
+// and deterministic: the same items in the same order give the same sweeps, which is what
+// makes a replay exact. The daemon's processing thread, the evaluations, and the tests all run
+// it through its one entry, process().
 //
 // Per packet, as it arrives: decode (vlp16::StreamDecoder) → the sensor's pose at each
-// firing's time (pose::FiringPoses, or one pose for the sweep) → transform into the global
-// frame → ROI membership (roi::GridFilter, exact) → append the kept points to the sweep. At a
-// sweep's first packet the ROI chain is placed: centres every d from the robot's projection
-// on the active trajectory over the look-ahead (growing with speed when configured); a new
-// trajectory offered in between is swapped in there, never inside a sweep. At the sweep's
-// end the sweep goes to the SweepSink.
+// firing's time (pose::FiringPoses, or one pose for the sweep) → placement in the global frame
+// (roi::transform_records) → ROI membership (roi::RoiChain, exact) → append the kept points to
+// the sweep. At a sweep's first packet the ROI chain is placed: centres every d from the
+// robot's projection on the active trajectory over the look-ahead (growing with speed when
+// configured); a new trajectory offered in between is swapped in there, never inside a sweep.
+// At the sweep's end the sweep goes to the SweepSink.
 //
 // No allocation once warm: every buffer is sized at construction (points per sweep up to
 // buffers.max_points_per_sweep; more are counted as truncated) and reused.
 #include <Eigen/Geometry>
-#include <array>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -26,121 +26,18 @@
 #include <vector>
 
 #include "trajroi/daemon/config.hpp"
+#include "trajroi/inputs/input_source.hpp"
+#include "trajroi/pipeline/sweep.hpp"
 #include "trajroi/pose/pose_buffer.hpp"
 #include "trajroi/pose_input/pose_input.hpp"
-#include "trajroi/roi/centres.hpp"
-#include "trajroi/roi/filter_stats.hpp"
-#include "trajroi/roi/grid_filter.hpp"
-#include "trajroi/roi/point.hpp"
-#include "trajroi/roi/shapes.hpp"
-#include "trajroi/roi/trajectory.hpp"
+#include "trajroi/roi/roi_chain.hpp"
 #include "trajroi/vlp16/stream_decoder.hpp"
 
-namespace trajroi::daemon {
+namespace trajroi::pipeline {
 
-// A trajectory with the id it is published under (0: the configured file's).
-struct ActiveTrajectory {
-  roi::Trajectory trajectory;
-  std::int32_t id = 0;
-};
-
-// Sensor or robot pose as published: translation and unit quaternion (w, x, y, z). The
-// isometry the daemon computes with is rebuilt from exactly these numbers, so a consumer that
-// rebuilds it the same way (Quaterniond(w, x, y, z).toRotationMatrix()) transforms
-// bit-identically.
-struct PublishedPose {
-  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
-  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
-  [[nodiscard]] static PublishedPose from(const Eigen::Isometry3d& pose);
-  [[nodiscard]] Eigen::Isometry3d isometry() const;
-};
-
-// A sweep's description: everything but its kept points.
-struct SweepHeader {
-  std::uint64_t index = 0;
-  std::int64_t start_ns = 0;
-  std::int64_t end_ns = 0;
-  bool partial = false;
-  std::uint8_t return_mode = 0;
-  std::uint32_t points_in = 0;
-  std::uint32_t lost_packets = 0;
-  std::uint32_t truncated = 0;  // kept points beyond the buffer
-
-  // The pose: `filtered` only when it was valid for every point.
-  bool filtered = false;
-  pose::PoseStatus pose_status = pose::PoseStatus::kNoGnss;
-  double pose_measured = 0.0, pose_limit = 0.0;  // the failing figure and its limit (PoseQuery)
-  std::string_view heading_source = "none";      // where the attitude came from (static text)
-  // The sweep's start in UTC (ns since 1970; 0: unknown) and where that came from: "vlp16_pps"
-  // (the sensor's PPS-locked clock, its position packets with a valid RMC), "host" (the host's
-  // CLOCK_REALTIME, live), "none" (a replay without a PPS-locked sensor).
-  std::int64_t start_utc_ns = 0;
-  std::string_view time_source = "none";
-  std::int64_t pose_t_ns = 0;  // sweep start
-  PublishedPose robot;         // global_from_robot at the start
-  PublishedPose sensor;        // global_from_lidar at the start (used for the whole
-                               // sweep in per-sweep mode)
-  double speed_mps = 0.0;      // over the last 0.5 s (0.2 s, 0.1 s after a pose gap)
-  bool speed_known = false;    // false: the pose valid for less than 0.1 s (speed_mps 0)
-  pose::FixQuality fix;        // newest fix at the sweep's start
-  std::int64_t fix_t_ns = 0;   // its time (0: none)
-
-  // The ROI chain.
-  std::int32_t trajectory_id = 0;
-  RoiShape shape = RoiShape::kCircular;
-  double radius_m = 0.0, height_m = 0.0, width_m = 0.0, spacing_m = 0.0;
-  double start_s_m = 0.0, look_ahead_m = 0.0;
-  std::vector<roi::Centre> centres;
-
-  // Steady-clock bookkeeping: when the last datagram with points of this sweep arrived (set
-  // from set_input_arrival), and the processing time the wiring measured.
-  std::int64_t last_packet_arrival_ns = 0;
-  std::int64_t processing_ns = 0;
-  // Set by the wiring as it hands the sweep over: when the processing of the packet that
-  // closed it began, and when it went to the publisher (a late sweep's log line says where
-  // its time went).
-  std::int64_t closing_packet_start_ns = 0;
-  std::int64_t handed_over_ns = 0;
-};
-
-struct Sweep : SweepHeader {
-  // Grown by resize() and then written: its new elements are left unwritten, not zeroed.
-  template <typename T>
-  using Array = std::vector<T, roi::DefaultInitAllocator<T>>;
-  // Kept points, global frame, structure of arrays.
-  Array<float> x, y, z;
-  Array<std::uint8_t> intensity, ring, return_type;
-  Array<std::int32_t> time_offset_ns;
-  // With SweepProcessor::keep_point_indices(): each kept point's index among the decoded
-  // sweep's points (vlp16::Frame::points), for scoring against per-point truth.
-  Array<std::uint32_t> point_index;
-
-  // Becomes `other`: its header copied, its kept points taken by exchanging arrays, so that
-  // `other` is left with this sweep's arrays (their capacity: nothing is allocated, nothing
-  // copied, when both were reserved alike) and its points are to be cleared. The point
-  // indices are copied.
-  void take(Sweep& other);
-  void reserve(std::size_t points, std::size_t centres);
-  // Empties the sweep and writes a page of its arrays' capacity at a time, so that the reserved
-  // memory is resident: a sweep larger than any before it then takes no page fault, and a
-  // flood or a busier scene does not grow the resident memory.
-  void make_resident();
-  void clear_points() noexcept;
-  [[nodiscard]] std::size_t size() const noexcept { return x.size(); }
-};
-
-enum class LidarPort : std::uint8_t { kData, kPosition };
-
-class SweepSink {
- public:
-  virtual ~SweepSink() = default;
-  // `sweep` is valid during the call only; the sink may take its points (Sweep::take).
-  virtual void on_sweep(Sweep& sweep) = 0;
-  // Every run of points as placed in the global frame, before the ROI: `placed[k]` is the
-  // frame's point `first + k`. Only while the sweep's pose is valid. For the evaluations.
-  virtual void on_placed(const vlp16::Frame& /*frame*/, std::size_t /*first*/,
-                         std::span<const roi::PointXYZI> /*placed*/) {}
-};
+using daemon::DaemonConfig;
+using daemon::PoseMode;
+using daemon::PoseSource;
 
 struct ProcessorCounters {
   std::uint64_t sweeps = 0;
@@ -154,6 +51,12 @@ struct ProcessorCounters {
   std::uint64_t pose_messages_malformed = 0;  // pose_input_t that did not decode, or unknown clock / frame
 };
 
+// The configured calibration (lidar.calibration; the manual's values when none) and decoding
+// options (ranges, the sweep's cut azimuth): what the processor decodes with. Throws
+// config::ConfigError for a calibration file that cannot be read or parsed.
+[[nodiscard]] vlp16::Calibration load_calibration(const DaemonConfig& config);
+[[nodiscard]] vlp16::StreamOptions stream_options(const DaemonConfig& config);
+
 // How the configuration sets up the pose input (IMU mounting and declination, the delays).
 [[nodiscard]] pose_input::PoseInputConfig pose_input_config(const DaemonConfig& config);
 
@@ -163,30 +66,23 @@ class SweepProcessor {
   ~SweepProcessor();
 
   // Times the ROI filter's scans for the configured shape on its start-up grid and makes
-  // the fastest on this machine the one used (roi::GridFilter::calibrate); at start, before
+  // the fastest on this machine the one used (roi::RoiChain::calibrate); at start, before
   // the first sweep.
-  roi::ScanCalibration calibrate_scan() const;
+  roi::ScanCalibration calibrate_scan() const { return chain_.calibrate(); }
   // Makes the sweep it fills resident (Sweep::make_resident); at start, before the first
   // datagram.
   void make_resident() { sweep_.make_resident(); }
 
-  // `decoded`: a data packet's points decoded ahead by packet_decoder() (vlp16::StreamDecoder::
-  // on_data_packet), or null.
-  void lidar_datagram(LidarPort port, std::span<const std::uint8_t> payload, std::int64_t receive_ns, SweepSink& sink,
-                      const vlp16::DecodedPacket* decoded = nullptr);
+  // The one entry: an input item of any stream, in the inputs' global order. LiDAR data
+  // packets are decoded and their points placed and filtered, sweeps going to `sink` as they
+  // end; position packets give the sensor's clock; GNSS and IMU bytes and localization messages
+  // (pose.source lcm: 8 bytes of CLOCK_REALTIME − CLOCK_MONOTONIC at receipt, little-endian,
+  // then the pose_input_t; one that does not decode is counted) feed the pose. `decoded`: a data
+  // packet's points decoded ahead by packet_decoder() on another thread, or null.
+  void process(const inputs::InputItem& item, SweepSink& sink, const vlp16::DecodedPacket* decoded = nullptr);
   // The packet decoder the stream decodes with: const and stateless, for another thread to
   // decode packets ahead.
   [[nodiscard]] const vlp16::PacketDecoder& packet_decoder() const noexcept { return decoder_.decoder(); }
-  void gnss_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) {
-    pose_input_.gnss_bytes(bytes, receive_ns);
-  }
-  void imu_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) {
-    pose_input_.imu_bytes(bytes, receive_ns);
-  }
-  // A pose_input_t from the robot's localization (pose.source lcm) as its input hands it over:
-  // 8 bytes of (CLOCK_REALTIME − CLOCK_MONOTONIC) at its receipt, little-endian, then the LCM
-  // message. A message that does not decode is counted.
-  void pose_message(std::span<const std::uint8_t> bytes, std::int64_t receive_ns);
   // Steady-clock time the next datagram entered the daemon: a sweep keeps that of the last
   // datagram that gave it points (for the latency figures; no effect on the output).
   void set_input_arrival(std::int64_t steady_ns) noexcept { arrival_ns_ = steady_ns; }
@@ -224,7 +120,11 @@ class SweepProcessor {
 
  private:
   class FrameAdapter;
+  void pose_message(std::span<const std::uint8_t> bytes);
   void start_sweep(const vlp16::Frame& frame);
+  // Projects the robot's position on the active trajectory (within the window after the last
+  // sweep's projection, or anywhere after a jump) and places the sweep's ROI chain there.
+  void place_chain(const Eigen::Vector2d& position);
   void add_points(const vlp16::Frame& frame, std::size_t first, SweepSink& sink);
   void end_sweep(const vlp16::Frame& frame, SweepSink& sink);
   // Filters the frame's points not filtered yet, in batches, while at least `at_least` wait.
@@ -249,10 +149,7 @@ class SweepProcessor {
   bool have_hint_ = false;
   std::optional<std::int64_t> valid_since_ns_;  // first sweep start of the current valid run
 
-  roi::CircularRoiSet circles_;
-  roi::RectangularRoiSet rects_;
-  roi::GridFilter<roi::CircularRoiSet> circle_grid_;
-  roi::GridFilter<roi::RectangularRoiSet> rect_grid_;
+  roi::RoiChain chain_;
 
   Sweep sweep_;
   bool in_sweep_ = false;
@@ -265,4 +162,4 @@ class SweepProcessor {
   ProcessorCounters counters_;
 };
 
-}  // namespace trajroi::daemon
+}  // namespace trajroi::pipeline

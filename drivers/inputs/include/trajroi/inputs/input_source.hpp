@@ -73,8 +73,4 @@ class InputSource {
   [[nodiscard]] virtual std::string describe() const = 0;
 };
 
-// The host clocks, in ns.
-[[nodiscard]] std::int64_t monotonic_ns() noexcept;
-[[nodiscard]] std::int64_t realtime_ns() noexcept;
-
 }  // namespace trajroi::inputs

@@ -41,7 +41,4 @@ class ByteSource {
   [[nodiscard]] virtual std::string describe() const = 0;
 };
 
-// The host monotonic clock in ns (CLOCK_MONOTONIC), the time base of every receive stamp.
-[[nodiscard]] std::int64_t monotonic_now_ns() noexcept;
-
 }  // namespace trajroi::serial

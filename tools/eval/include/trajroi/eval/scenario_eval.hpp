@@ -19,15 +19,16 @@
 #include <vector>
 
 #include "trajroi/daemon/config.hpp"
-#include "trajroi/daemon/sweep_processor.hpp"
 #include "trajroi/eval/artificial.hpp"
 #include "trajroi/eval/timing.hpp"
+#include "trajroi/pipeline/sweep_processor.hpp"
 #include "trajroi/pose/pose_buffer.hpp"
 #include "trajroi/pose_input/pose_input.hpp"
 #include "trajroi/roi/centres.hpp"
 #include "trajroi/roi/grid_filter.hpp"
 #include "trajroi/roi/metrics.hpp"
 #include "trajroi/roi/point.hpp"
+#include "trajroi/roi/roi_chain.hpp"
 #include "trajroi/roi/shapes.hpp"
 #include "trajroi/roi/trajectory.hpp"
 #include "trajroi/sim/run_folder.hpp"
@@ -86,7 +87,7 @@ class PipelineObserver {
   virtual ~PipelineObserver() = default;
   // Each sweep of configuration `config`, with the time the processor spent on its packets
   // (decode, pose, transform, ROI), in ms.
-  virtual void on_sweep(std::size_t config, const daemon::Sweep& sweep, double processing_ms) = 0;
+  virtual void on_sweep(std::size_t config, const pipeline::Sweep& sweep, double processing_ms) = 0;
   // Each run of points placed in the global frame (while the sweep's pose is valid).
   virtual void on_placed(std::size_t /*config*/, const vlp16::Frame& /*frame*/, std::size_t /*first*/,
                          std::span<const roi::PointXYZI> /*placed*/) {}
@@ -102,24 +103,22 @@ void run_pipelines(const ScenarioRun& run, std::span<const daemon::DaemonConfig>
 void place_frame_truth(const vlp16::Frame& frame, const sim::TruthPoses& truth,
                        const Eigen::Isometry3d& robot_from_lidar, std::vector<roi::PointXYZd>& out);
 
-// A chain of ROIs filtering one cloud: centres from s0 over the look-ahead at a spacing
-// ratio of the shape's size along the trajectory, the ROI set, its grid and the filter. The
-// sets, grids and index storage are reused from call to call.
+// The evaluation's chains filtering one cloud: roi::RoiChain (the daemon's own) for each shape
+// at the scenario's evaluation sizes, the spacing a ratio of the shape's size along the
+// trajectory. Storage is reused from call to call.
 class RoiChain {
  public:
   explicit RoiChain(const sim::EvaluationSpec& spec);
   void run(const roi::Trajectory& trajectory, double s0_m, double look_ahead_m, RoiShape shape, int ratio_pct,
            std::span<const roi::PointXYZI> points);
-  [[nodiscard]] const std::vector<roi::Centre>& centres() const noexcept { return centres_; }
+  [[nodiscard]] const std::vector<roi::Centre>& centres() const noexcept { return last_->centres(); }
   [[nodiscard]] const roi::IndexVector& kept() const noexcept { return kept_; }
 
  private:
   sim::EvaluationSpec spec_;
-  std::vector<roi::Centre> centres_;
-  roi::CircularRoiSet circles_;
-  roi::RectangularRoiSet rects_;
-  roi::GridFilter<roi::CircularRoiSet> circle_grid_;
-  roi::GridFilter<roi::RectangularRoiSet> rect_grid_;
+  roi::RoiChain circles_;
+  roi::RoiChain rects_;
+  const roi::RoiChain* last_ = &circles_;
   roi::IndexVector kept_;
 };
 

@@ -1,0 +1,78 @@
+#include "trajroi/pipeline/sweep.hpp"
+
+#include "trajroi/roi/transform.hpp"
+
+namespace trajroi::pipeline {
+namespace {
+
+// Writes one element in every page of an empty array's capacity, so that its memory is
+// resident (see Sweep::make_resident).
+template <typename Array>
+void touch_capacity(Array& a) {
+  a.resize(a.capacity());  // default-initialised: nothing written yet
+  constexpr std::size_t kStride = 4096 / sizeof(typename Array::value_type);
+  for (std::size_t i = 0; i < a.size(); i += kStride)
+    a[i] = typename Array::value_type{};
+  a.clear();
+}
+
+}  // namespace
+
+PublishedPose PublishedPose::from(const Eigen::Isometry3d& pose) {
+  PublishedPose p;
+  p.position_m = pose.translation();
+  p.orientation = Eigen::Quaterniond(pose.linear()).normalized();
+  if (p.orientation.w() < 0.0) p.orientation.coeffs() = -p.orientation.coeffs();
+  return p;
+}
+
+Eigen::Isometry3d PublishedPose::isometry() const {
+  return roi::pose_from_position_quaternion(position_m, orientation);
+}
+
+void Sweep::take(Sweep& other) {
+  static_cast<SweepHeader&>(*this) = other;
+  x.swap(other.x);
+  y.swap(other.y);
+  z.swap(other.z);
+  intensity.swap(other.intensity);
+  ring.swap(other.ring);
+  return_type.swap(other.return_type);
+  time_offset_ns.swap(other.time_offset_ns);
+  point_index = other.point_index;  // kept for evaluations only: unreserved in the ring's slots
+}
+
+void Sweep::reserve(std::size_t points, std::size_t centre_count) {
+  x.reserve(points);
+  y.reserve(points);
+  z.reserve(points);
+  intensity.reserve(points);
+  ring.reserve(points);
+  return_type.reserve(points);
+  time_offset_ns.reserve(points);
+  centres.reserve(centre_count);
+}
+
+void Sweep::make_resident() {
+  clear_points();
+  touch_capacity(x);
+  touch_capacity(y);
+  touch_capacity(z);
+  touch_capacity(intensity);
+  touch_capacity(ring);
+  touch_capacity(return_type);
+  touch_capacity(time_offset_ns);
+}
+
+void Sweep::clear_points() noexcept {
+  x.clear();
+  y.clear();
+  z.clear();
+  intensity.clear();
+  ring.clear();
+  return_type.clear();
+  time_offset_ns.clear();
+  point_index.clear();
+}
+
+}  // namespace trajroi::pipeline

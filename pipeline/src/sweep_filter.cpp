@@ -1,0 +1,140 @@
+// The processor's per-point work: a sweep's points placed in the global frame a batch at a
+// time (one pose per firing, or the sweep's), filtered against the sweep's ROI chain, and the
+// kept ones appended to the sweep; and the sweep's end.
+#include <algorithm>
+
+#include "processor_constants.hpp"
+#include "trajroi/pipeline/sweep_processor.hpp"
+#include "trajroi/roi/transform.hpp"
+
+namespace trajroi::pipeline {
+
+void SweepProcessor::add_points(const vlp16::Frame& frame, std::size_t first, SweepSink& sink) {
+  if (first == 0 || !in_sweep_) {
+    start_sweep(frame);
+    unfiltered_from_ = first;
+  }
+  sweep_.last_packet_arrival_ns = arrival_ns_;
+  // The points wait until a whole batch has come (a few packets, a millisecond or two of the
+  // sensor's): the scan and the placing are set up once per batch, not per packet (as-fast
+  // replay of the dual-return corridor: processing thread 12 % less). Their firings' poses
+  // are taken then, from the GNSS and IMU samples received until then, in the order of
+  // arrival as before (one that came meanwhile interpolates where it was extrapolated). The
+  // sweep's end filters the rest.
+  filter_points(frame, kScratchPoints, sink);
+}
+
+void SweepProcessor::filter_points(const vlp16::Frame& frame, std::size_t at_least, SweepSink& sink) {
+  const std::size_t end = frame.points.size();
+  for (; unfiltered_from_ < end && end - unfiltered_from_ >= at_least && sweep_.filtered;
+       unfiltered_from_ = std::min(end, unfiltered_from_ + kScratchPoints)) {
+    const std::size_t i = unfiltered_from_;
+    const pose::PoseStatus status = filter_batch(frame, i, std::min(end, i + kScratchPoints), sink);
+    if (status != pose::PoseStatus::kValid) {
+      sweep_.filtered = false;
+      sweep_.pose_status = status;
+      sweep_.pose_measured = firing_.measured();
+      sweep_.pose_limit = firing_.limit();
+      sweep_.clear_points();
+      have_hint_ = false;
+    }
+  }
+}
+
+pose::PoseStatus SweepProcessor::filter_batch(const vlp16::Frame& frame, std::size_t first, std::size_t end,
+                                              SweepSink& sink) {
+  const auto place_run = [&](std::size_t from, std::size_t to, const Eigen::Isometry3d& global_from_lidar) {
+    roi::transform_records(global_from_lidar, std::span(frame.points).subspan(from, to - from),
+                           scratch_.data() + (from - first));
+  };
+  if (config_.pose_mode == PoseMode::kPerSweep) {
+    place_run(first, end, sweep_sensor_pose_);
+  } else {
+    // Per firing: the points of one firing period (in time order) share a pose.
+    for (std::size_t i = first; i < end;) {
+      pose::PoseStatus status{};
+      const Eigen::Isometry3d* pose = firing_.at(frame.start_time_ns + frame.points[i].time_offset_ns, status);
+      if (pose == nullptr) return status;
+      // The following points the same pose covers, in the frame's time offsets.
+      const pose::FiringPoses::Window window = firing_.window_after(frame.start_time_ns);
+      std::size_t j = i + 1;
+      while (j < end && window.contains(frame.points[j].time_offset_ns))
+        ++j;
+      place_run(i, j, *pose);
+      i = j;
+    }
+  }
+  const std::span<const roi::PointXYZI> placed(scratch_.data(), end - first);
+  sink.on_placed(frame, first, placed);
+  (void)chain_.filter(placed, kept_);
+  Sweep& s = sweep_;
+  const std::size_t room =
+      config_.buffers.max_points_per_sweep - std::min(config_.buffers.max_points_per_sweep, s.size());
+  const std::size_t n = std::min(room, kept_.size());
+  s.truncated += static_cast<std::uint32_t>(kept_.size() - n);
+  // Grown once, then written through pointers (push_back would store each array's end at
+  // every point: the compiler cannot tell the arrays apart).
+  const std::size_t at = s.size();
+  const auto grown = [at, n](auto& v) {
+    v.resize(at + n);
+    return v.data() + at;
+  };
+  float* const x = grown(s.x);
+  float* const y = grown(s.y);
+  float* const z = grown(s.z);
+  std::uint8_t* const intensity = grown(s.intensity);
+  std::uint8_t* const ring = grown(s.ring);
+  std::uint8_t* const return_type = grown(s.return_type);
+  std::int32_t* const time_offset_ns = grown(s.time_offset_ns);
+  // The sources in locals too: every byte stored may alias anything, so the compiler would
+  // reload the vectors' data pointers after each one.
+  const std::uint32_t* const kept = kept_.data();
+  const roi::PointXYZI* const placed_at = scratch_.data();
+  const vlp16::Point* const batch = frame.points.data() + first;
+  for (std::size_t k = 0; k < n; ++k) {
+    const roi::PointXYZI& g = placed_at[kept[k]];
+    const vlp16::Point& p = batch[kept[k]];
+    x[k] = g.x;
+    y[k] = g.y;
+    z[k] = g.z;
+    intensity[k] = p.intensity;
+    ring[k] = p.ring;
+    return_type[k] = static_cast<std::uint8_t>(p.return_type);
+    time_offset_ns[k] = static_cast<std::int32_t>(p.time_offset_ns);
+  }
+  if (keep_indices_) {
+    std::uint32_t* const index = grown(s.point_index);
+    for (std::size_t k = 0; k < n; ++k)
+      index[k] = static_cast<std::uint32_t>(first + kept[k]);
+  }
+  return pose::PoseStatus::kValid;
+}
+
+void SweepProcessor::end_sweep(const vlp16::Frame& frame, SweepSink& sink) {
+  if (!in_sweep_) {
+    start_sweep(frame);  // a frame of packets without points
+    unfiltered_from_ = frame.points.size();
+  }
+  filter_points(frame, 1, sink);
+  in_sweep_ = false;
+  Sweep& s = sweep_;
+  s.index = frame.index;
+  s.end_ns = frame.end_time_ns;
+  s.partial = frame.partial;
+  s.return_mode = static_cast<std::uint8_t>(frame.return_mode);
+  s.points_in = static_cast<std::uint32_t>(frame.points.size());
+  s.lost_packets = frame.lost_packets;
+  ++counters_.sweeps;
+  counters_.points_in += frame.points.size();
+  if (s.filtered) {
+    ++counters_.sweeps_filtered;
+    counters_.points_kept += s.size();
+    counters_.points_truncated += s.truncated;
+  } else {
+    ++counters_.sweeps_without_pose;
+    s.clear_points();
+  }
+  sink.on_sweep(s);
+}
+
+}  // namespace trajroi::pipeline
