@@ -27,7 +27,7 @@ echo "Pictures: out/svg/*.svg (artificial frames), out/keyframes/*.svg, out/tabl
 echo
 rate=${TRAJROI_DEMO_RATE:-10}
 echo "trajroid: replaying out/runs/factory at --rate $rate over LCM udpm://239.255.76.67:7667?ttl=0"
-./build/release/tools/trajroi watch --run out/runs/factory --lcm-url 'udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304' \
+./build/release/tools/trajroi watch --run out/runs/factory --lcm-url 'udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216' \
   --seconds 0 >out/watch.txt &
 watcher=$!
 sleep 1

@@ -14,72 +14,18 @@ constexpr std::size_t at(Counter c) {
   return static_cast<std::size_t>(c);
 }
 
-// Names, built once: the decoders' enums give the names of their blocks.
+// Names, built once from the list: a block's names from its decoder's enum.
 struct Names {
   std::array<std::string, kCounterCount> name;
   Names() {
-    const auto set = [this](Counter c, const char* n) { name[at(c)] = n; };
-    set(C::kRingDropsLidar, "ring_drops.lidar");
-    set(C::kRingDropsGnss, "ring_drops.gnss");
-    set(C::kRingDropsImu, "ring_drops.imu");
-    set(C::kRingDropsSweeps, "ring_drops.sweeps");
-    set(C::kRingDropsStatus, "ring_drops.status");
-    set(C::kRingDropsTrajectory, "ring_drops.trajectory");
-    set(C::kRingDropsRecord, "ring_drops.record");
-    set(C::kLidarOversize, "lidar.oversize_datagrams");
-    set(C::kLidarSourceErrors, "lidar.source_errors");
-    set(C::kLidarRejectedSource, "lidar.rejected_source");
-    set(C::kLidarKernelDrops, "lidar.kernel_drops");
-    for (std::size_t e = 1; e < vlp16::kPacketErrorCount; ++e) {
-      name[at(C::kLidarRejected) + e - 1] =
-          "lidar.rejected." + std::string(vlp16::to_string(static_cast<vlp16::PacketError>(e)));
-    }
-    set(C::kLidarOutOfOrder, "lidar.out_of_order");
-    set(C::kLidarRestarts, "lidar.restarts");
-    set(C::kLidarLateDropped, "lidar.late_dropped");
-    set(C::kLidarDuplicates, "lidar.duplicates");
-    set(C::kLidarClockResets, "lidar.clock_resets");
-    set(C::kLidarClockJumps, "lidar.clock_jumps");
-    set(C::kLidarNoReturn, "lidar.no_return");
-    set(C::kLidarOutOfRange, "lidar.out_of_range");
-    set(C::kLidarPartialSweeps, "lidar.partial_sweeps");
-    set(C::kLidarPositionWrongSize, "lidar.position_wrong_size");
-    for (std::size_t e = 1; e < vlp16::kNmeaErrorCount; ++e) {
-      name[at(C::kLidarNmea) + e - 1] = "lidar.nmea." + std::string(vlp16::to_string(static_cast<vlp16::NmeaError>(e)));
-    }
-    set(C::kGnssBytes, "gnss.bytes");
-    set(C::kGnssFrames, "gnss.frames");
-    set(C::kGnssSkippedBytes, "gnss.skipped_bytes");
-    set(C::kGnssChecksumErrors, "gnss.checksum_errors");
-    set(C::kGnssBadLengths, "gnss.bad_lengths");
-    set(C::kImuBytes, "imu.bytes");
-    set(C::kImuFrames, "imu.frames");
-    set(C::kImuSkippedBytes, "imu.skipped_bytes");
-    set(C::kImuChecksumErrors, "imu.checksum_errors");
-    set(C::kImuBadLengths, "imu.bad_lengths");
-    set(C::kSerialDisconnects, "serial.disconnects");
-    set(C::kPoseFixes, "pose.fixes");
-    set(C::kPoseHighPrecisionFixes, "pose.high_precision_fixes");
-    set(C::kPoseInvalidPosition, "pose.invalid_position");
-    set(C::kPoseMalformedMessages, "pose.malformed_messages");
-    set(C::kPoseAttitudes, "pose.attitudes");
-    set(C::kPoseImuWithoutAttitude, "pose.imu_without_attitude");
-    set(C::kPoseImuReceiveStamped, "pose.imu_receive_stamped");
-    set(C::kPoseGnssHeadings, "pose.gnss_headings");
-    set(C::kPoseUbxOther, "pose.ubx_other_messages");
-    set(C::kGnssForeignFrames, "gnss.vn100_frames");
-    set(C::kImuForeignFrames, "imu.ubx_frames");
-    set(C::kPoseExternal, "pose.localization_poses");
-    set(C::kPoseExternalInvalid, "pose.localization_invalid");
-    set(C::kPoseMessagesMalformed, "pose.localization_malformed");
-    set(C::kRingDropsPose, "ring_drops.pose_input");
-    set(C::kPoseRefusedSamples, "pose.refused_samples");
-    set(C::kPoseGnssClockResets, "pose.gnss_clock_resets");
-    set(C::kPoseImuClockResets, "pose.imu_clock_resets");
-    set(C::kSweepsPointsTruncated, "sweeps.points_truncated");
-    set(C::kTrajectorySwaps, "trajectory.swaps");
-    set(C::kTrajectoryProjectionReacquired, "trajectory.projection_reacquired");
-    set(C::kLidarDecodedAhead, "lidar.decoded_ahead");
+#define TRAJROI_COUNTER_NAME(id, text) name[at(C::id)] = text;
+#define TRAJROI_COUNTER_BLOCK_NAMES(id, prefix, Enum, count)                                \
+  for (std::size_t e = 1; e < (count); ++e) {                                               \
+    name[at(C::id) + e - 1] = prefix + std::string(vlp16::to_string(static_cast<Enum>(e))); \
+  }
+    TRAJROI_STATUS_COUNTERS(TRAJROI_COUNTER_NAME, TRAJROI_COUNTER_BLOCK_NAMES)
+#undef TRAJROI_COUNTER_NAME
+#undef TRAJROI_COUNTER_BLOCK_NAMES
   }
 };
 

@@ -16,65 +16,75 @@ namespace trajroi::daemon {
 
 struct Pipeline;
 
-// Ranges of the decoders' own error enums sit in the table as blocks (their kNone omitted).
+// Every counter of the status table, once, in the message's order: X(id, name) is one counter;
+// B(id, prefix, Enum, count) a block of one counter per value of a decoder's error enum (its
+// kNone, value 0, omitted), each named prefix + the value's name. The enum and the names are
+// both made from this list.
+#define TRAJROI_STATUS_COUNTERS(X, B)                                                \
+  X(kRingDropsLidar, "ring_drops.lidar")                                             \
+  X(kRingDropsGnss, "ring_drops.gnss")                                               \
+  X(kRingDropsImu, "ring_drops.imu")                                                 \
+  X(kRingDropsSweeps, "ring_drops.sweeps")                                           \
+  X(kRingDropsStatus, "ring_drops.status")                                           \
+  X(kRingDropsTrajectory, "ring_drops.trajectory")                                   \
+  X(kRingDropsRecord, "ring_drops.record")                                           \
+  X(kLidarOversize, "lidar.oversize_datagrams")                                      \
+  X(kLidarSourceErrors, "lidar.source_errors")                                       \
+  X(kLidarRejectedSource, "lidar.rejected_source")                                   \
+  X(kLidarKernelDrops, "lidar.kernel_drops")                                         \
+  B(kLidarRejected, "lidar.rejected.", vlp16::PacketError, vlp16::kPacketErrorCount) \
+  X(kLidarOutOfOrder, "lidar.out_of_order")                                          \
+  X(kLidarRestarts, "lidar.restarts")                                                \
+  X(kLidarLateDropped, "lidar.late_dropped")                                         \
+  X(kLidarDuplicates, "lidar.duplicates")                                            \
+  X(kLidarClockResets, "lidar.clock_resets")                                         \
+  X(kLidarClockJumps, "lidar.clock_jumps")                                           \
+  X(kLidarNoReturn, "lidar.no_return")                                               \
+  X(kLidarOutOfRange, "lidar.out_of_range")                                          \
+  X(kLidarPartialSweeps, "lidar.partial_sweeps")                                     \
+  X(kLidarPositionWrongSize, "lidar.position_wrong_size")                            \
+  B(kLidarNmea, "lidar.nmea.", vlp16::NmeaError, vlp16::kNmeaErrorCount)             \
+  X(kGnssBytes, "gnss.bytes")                                                        \
+  X(kGnssFrames, "gnss.frames")                                                      \
+  X(kGnssSkippedBytes, "gnss.skipped_bytes")                                         \
+  X(kGnssChecksumErrors, "gnss.checksum_errors")                                     \
+  X(kGnssBadLengths, "gnss.bad_lengths")                                             \
+  X(kImuBytes, "imu.bytes")                                                          \
+  X(kImuFrames, "imu.frames")                                                        \
+  X(kImuSkippedBytes, "imu.skipped_bytes")                                           \
+  X(kImuChecksumErrors, "imu.checksum_errors")                                       \
+  X(kImuBadLengths, "imu.bad_lengths")                                               \
+  X(kSerialDisconnects, "serial.disconnects")                                        \
+  X(kPoseFixes, "pose.fixes")                                                        \
+  X(kPoseHighPrecisionFixes, "pose.high_precision_fixes")                            \
+  X(kPoseInvalidPosition, "pose.invalid_position")                                   \
+  X(kPoseMalformedMessages, "pose.malformed_messages")                               \
+  X(kPoseAttitudes, "pose.attitudes")                                                \
+  X(kPoseImuWithoutAttitude, "pose.imu_without_attitude")                            \
+  X(kPoseImuReceiveStamped, "pose.imu_receive_stamped")                              \
+  X(kPoseGnssHeadings, "pose.gnss_headings")                                         \
+  X(kPoseUbxOther, "pose.ubx_other_messages")                                        \
+  X(kGnssForeignFrames, "gnss.vn100_frames")                                         \
+  X(kImuForeignFrames, "imu.ubx_frames")                                             \
+  X(kPoseExternal, "pose.localization_poses")                                        \
+  X(kPoseExternalInvalid, "pose.localization_invalid")                               \
+  X(kPoseMessagesMalformed, "pose.localization_malformed")                           \
+  X(kRingDropsPose, "ring_drops.pose_input")                                         \
+  X(kPoseRefusedSamples, "pose.refused_samples")                                     \
+  X(kPoseGnssClockResets, "pose.gnss_clock_resets")                                  \
+  X(kPoseImuClockResets, "pose.imu_clock_resets")                                    \
+  X(kSweepsPointsTruncated, "sweeps.points_truncated")                               \
+  X(kTrajectorySwaps, "trajectory.swaps")                                            \
+  X(kTrajectoryProjectionReacquired, "trajectory.projection_reacquired")             \
+  X(kLidarDecodedAhead, "lidar.decoded_ahead")
+
 enum class Counter : std::uint16_t {
-  kRingDropsLidar,
-  kRingDropsGnss,
-  kRingDropsImu,
-  kRingDropsSweeps,
-  kRingDropsStatus,
-  kRingDropsTrajectory,
-  kRingDropsRecord,
-  kLidarOversize,
-  kLidarSourceErrors,
-  kLidarRejectedSource,
-  kLidarKernelDrops,
-  kLidarRejected,  // + PacketError − 1
-  kLidarOutOfOrder = kLidarRejected + vlp16::kPacketErrorCount - 1,
-  kLidarRestarts,
-  kLidarLateDropped,
-  kLidarDuplicates,
-  kLidarClockResets,
-  kLidarClockJumps,
-  kLidarNoReturn,
-  kLidarOutOfRange,
-  kLidarPartialSweeps,
-  kLidarPositionWrongSize,
-  kLidarNmea,  // + NmeaError − 1
-  kGnssBytes = kLidarNmea + vlp16::kNmeaErrorCount - 1,
-  kGnssFrames,
-  kGnssSkippedBytes,
-  kGnssChecksumErrors,
-  kGnssBadLengths,
-  kImuBytes,
-  kImuFrames,
-  kImuSkippedBytes,
-  kImuChecksumErrors,
-  kImuBadLengths,
-  kSerialDisconnects,
-  kPoseFixes,
-  kPoseHighPrecisionFixes,
-  kPoseInvalidPosition,
-  kPoseMalformedMessages,
-  kPoseAttitudes,
-  kPoseImuWithoutAttitude,
-  kPoseImuReceiveStamped,
-  kPoseGnssHeadings,
-  kPoseUbxOther,
-  kGnssForeignFrames,
-  kImuForeignFrames,
-  kPoseExternal,
-  kPoseExternalInvalid,
-  kPoseMessagesMalformed,
-  kRingDropsPose,
-  kPoseRefusedSamples,
-  kPoseGnssClockResets,
-  kPoseImuClockResets,
-  kSweepsPointsTruncated,
-  kTrajectorySwaps,
-  kTrajectoryProjectionReacquired,
-  kLidarDecodedAhead,
-  kCount
+#define TRAJROI_COUNTER_ID(id, name) id,
+#define TRAJROI_COUNTER_BLOCK(id, prefix, Enum, count) id, id##Last_ = id + (count)-2,
+  TRAJROI_STATUS_COUNTERS(TRAJROI_COUNTER_ID, TRAJROI_COUNTER_BLOCK)
+#undef TRAJROI_COUNTER_ID
+#undef TRAJROI_COUNTER_BLOCK
+      kCount
 };
 inline constexpr std::size_t kCounterCount = static_cast<std::size_t>(Counter::kCount);
 

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "pipeline.hpp"
+#include "trajroi/transport/receive_buffer.hpp"
 
 namespace trajroi::daemon {
 namespace {
@@ -115,8 +116,10 @@ UdpmReceiver::UdpmReceiver(std::string url, const LcmGroup& group, std::vector<s
       bind(fd_, reinterpret_cast<const sockaddr*>(&local), sizeof local) != 0) {
     fail("cannot bind port " + std::to_string(group.port));
   }
-  if (group.recv_buf_size > 0)
-    (void)setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &group.recv_buf_size, sizeof group.recv_buf_size);
+  if (group.recv_buf_size > 0) {
+    const transport::ReceiveBuffer buffer = transport::set_receive_buffer(fd_, group.recv_buf_size);
+    if (buffer.capped()) log::warn("{}", transport::describe_capped("LCM " + url_, buffer));
+  }
   if (exclude) {
     filters_ = drop_datagrams_from(fd_, *exclude);
     if (!filters_)

@@ -32,7 +32,8 @@ TEST(RoiChain, KeepsWhatTheDoubleLoopKeepsForEitherShapeAsItMoves) {
     double s0_m, look_ahead_m, spacing_m;
     ChainSize size;
   };
-  const Step steps[] = {{0.0, 12.0, 1.5, {1.5, 3.0, 2.5}}, {9.5, 15.0, 0.75, {2.25, 1.5, 4.0}}, {30.0, 100.0, 3.0, {1.0, 3.0, 1.0}}};
+  const Step steps[] = {
+      {0.0, 12.0, 1.5, {1.5, 3.0, 2.5}}, {9.5, 15.0, 0.75, {2.25, 1.5, 4.0}}, {30.0, 100.0, 3.0, {1.0, 3.0, 1.0}}};
   for (const RoiShape shape : {RoiShape::kCircular, RoiShape::kRectangular}) {
     RoiChain chain(shape, ChainSize{1.0, 2.0, 3.0}, z);
     chain.reserve(64);

@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -212,3 +213,39 @@ TEST_F(Cli, MachineReportsEveryCoreAndRefusesBadSettings) {
     EXPECT_NE(b.err.find("must be positive"), std::string::npos) << bad << ": " << b.err;
   }
 }
+
+namespace {
+
+long rmem_max_bytes() {
+  std::ifstream in("/proc/sys/net/core/rmem_max");
+  long bytes = 0;
+  in >> bytes;
+  return bytes;
+}
+
+// trajroi watch asks for its receive buffer past net.core.rmem_max where it may (root:
+// SO_RCVBUFFORCE) and says nothing; as an unprivileged user it says in one line how far the
+// kernel capped it and how to raise the limit.
+TEST_F(Cli, WatchTakesItsReceiveBufferOrSaysTheKernelCappedIt) {
+  if (geteuid() != 0) GTEST_SKIP() << "needs root (SO_RCVBUFFORCE, and setpriv to drop it)";
+  const long max = rmem_max_bytes();
+  ASSERT_GT(max, 0);
+  const long ask = std::min(4 * max, 1L << 29);
+  const std::string url = "'udpm://239.255.76.67:7667?ttl=0&recv_buf_size=" + std::to_string(ask) + "'";
+  const CommandResult root = run("watch --seconds 0.3 --lcm-url " + url);
+  EXPECT_EQ(root.exit_code, 0) << root.err;
+  EXPECT_EQ(root.err.find("capped"), std::string::npos) << root.err;
+
+  const fs::path err = dir_ / "nobody.txt";
+  const std::string command = "setpriv --reuid=65534 --regid=65534 --clear-groups " + std::string(TRAJROI_CLI) +
+                              " watch --seconds 0.3 --lcm-url " + url + " >/dev/null 2>" + err.string();
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << slurp(err);
+  const std::string expected = "trajroi watch: the kernel capped the LCM receive buffer at " +
+                               std::to_string(max / 1024) + " KiB of the " + std::to_string(ask / 1024) +
+                               " KiB asked for";
+  EXPECT_NE(slurp(err).find(expected), std::string::npos) << slurp(err);
+  EXPECT_NE(slurp(err).find("60-trajroi-lcm.conf"), std::string::npos) << slurp(err);
+}
+
+}  // namespace

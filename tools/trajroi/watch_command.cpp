@@ -31,6 +31,7 @@
 #include "trajroi/sim/run_folder.hpp"
 #include "trajroi/status_t.hpp"
 #include "trajroi/transport/lcm_subscribe.hpp"
+#include "trajroi/transport/receive_buffer.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
 #include "trajroi/vlp16/stream_decoder.hpp"
 
@@ -40,7 +41,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct WatchOptions {
-  std::string url = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304";
+  std::string url = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608";
   std::string prefix = "TRAJROI";
   std::string run_dir;
   double seconds = 0.0;
@@ -50,9 +51,7 @@ struct WatchOptions {
 class TruthScorer {
  public:
   explicit TruthScorer(const fs::path& dir)
-      : run_(dir),
-        source_(dir / sim::kLidarFile),
-        decoder_(vlp16::Calibration::vlp16_default(), run_.stream_options()) {}
+      : run_(dir), source_(dir / sim::kLidarFile), decoder_(run_.calibration(), run_.stream_options()) {}
 
   void score(const trajroi::points_t& m, const trajroi::roi_t& roi) {
     const vlp16::Frame* frame = frame_at(static_cast<std::uint64_t>(m.sweep_index));
@@ -192,7 +191,7 @@ class ScoringThread {
 
 class Watcher {
  public:
-  explicit Watcher(const WatchOptions& o) : o_(o), lcm_(o.url) {
+  explicit Watcher(const WatchOptions& o) : o_(o), lcm_(without_receive_buffer(o.url)) {
     if (!lcm_.good()) throw std::runtime_error("LCM: cannot open '" + o.url + "'");
     if (!o.run_dir.empty()) {
       scorer_ = std::make_unique<TruthScorer>(o.run_dir);
@@ -201,6 +200,7 @@ class Watcher {
     trajroi::transport::subscribe<&Watcher::on_points>(lcm_, o.prefix + "_POINTS", this);
     trajroi::transport::subscribe<&Watcher::on_roi>(lcm_, o.prefix + "_ROI", this);
     trajroi::transport::subscribe<&Watcher::on_status>(lcm_, o.prefix + "_STATUS", this);
+    take_receive_buffer();
   }
 
   void run() {
@@ -240,6 +240,27 @@ class Watcher {
   }
 
  private:
+  // liblcm sets the URL's recv_buf_size itself with SO_RCVBUF only, which the kernel caps at
+  // net.core.rmem_max without a word that counts: the watch asks for it, past the cap where it
+  // may, and says in one line when it was capped.
+  static std::string without_receive_buffer(const std::string& url) {
+    const std::size_t at = url.find("recv_buf_size=");
+    if (at == std::string::npos) return url;
+    std::size_t end = url.find('&', at);
+    std::string out = url.substr(0, at) + (end == std::string::npos ? "" : url.substr(end + 1));
+    while (!out.empty() && (out.back() == '&' || out.back() == '?'))
+      out.pop_back();
+    return out;
+  }
+  void take_receive_buffer() {
+    int bytes = 0;
+    std::uint16_t port = 0;
+    if (!transport::udpm_receive_options(o_.url, bytes, port) || bytes <= 0) return;
+    (void)lcm_.getFileno();  // liblcm makes its receive socket now
+    const transport::ReceiveBuffer buffer = transport::set_udp_receive_buffers(port, bytes);
+    if (buffer.capped()) std::fprintf(stderr, "%s\n", transport::describe_capped("trajroi watch", buffer).c_str());
+  }
+
   void on_points(const lcm::ReceiveBuffer*, const std::string&, const trajroi::points_t* m) {
     ++points_heard_;
     const auto roi = rois_.find(m->sweep_index);
@@ -276,7 +297,9 @@ class Watcher {
 void add_watch_command(CLI::App& app) {
   auto o = std::make_shared<WatchOptions>();
   CLI::App* cmd = app.add_subcommand("watch", "Listen to trajroid over LCM; score a replayed run against its truth");
-  cmd->add_option("--lcm-url", o->url, "LCM provider URL")->capture_default_str();
+  cmd->add_option("--lcm-url", o->url,
+                  "LCM provider URL (recv_buf_size is taken past net.core.rmem_max when run as root)")
+      ->capture_default_str();
   cmd->add_option("--channel-prefix", o->prefix, "Channels <prefix>_POINTS, _ROI, _STATUS")->capture_default_str();
   cmd->add_option("--run", o->run_dir, "The run folder being replayed (scores precision and recall)");
   cmd->add_option("--seconds", o->seconds, "Stop after this long (0: at the daemon's final status)")

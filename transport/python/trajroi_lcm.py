@@ -69,7 +69,7 @@ class Subscriber:
         self._socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
         self._socket.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         if recv_buf_size:
-            self._socket.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, recv_buf_size)
+            self._take_receive_buffer(recv_buf_size)
         self._socket.bind(("", int(port or 7667)))
         membership = struct.pack("4s4s", socket.inet_aton(group), socket.inet_aton("0.0.0.0"))
         self._socket.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, membership)
@@ -78,6 +78,23 @@ class Subscriber:
 
     def fileno(self):
         return self._socket.fileno()
+
+    def _take_receive_buffer(self, size):
+        """Asks for ``size`` bytes: past net.core.rmem_max where permitted (SO_RCVBUFFORCE,
+        root), else as much as the kernel allows, said on stderr in one line when capped."""
+        so_rcvbufforce = getattr(socket, "SO_RCVBUFFORCE", 33)
+        try:
+            self._socket.setsockopt(socket.SOL_SOCKET, so_rcvbufforce, size)
+        except PermissionError:
+            self._socket.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, size)
+        granted = self._socket.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) // 2
+        if granted < size:
+            sys.stderr.write(
+                "trajroi_lcm: the kernel capped the LCM receive buffer at %d KiB of the %d KiB asked for "
+                "(net.core.rmem_max); clouds may be lost when this subscriber falls behind. Run it as root, "
+                "or raise the limit with the drop-in trajroi ships: "
+                "sysctl -p /usr/lib/sysctl.d/60-trajroi-lcm.conf\n" % (granted // 1024, size // 1024))
+        return granted
 
     def subscribe(self, channel, handler):
         """``handler(channel, data)`` for every message on ``channel`` (exact name)."""

@@ -21,7 +21,6 @@ namespace trajroi::pipeline {
 
 using roi::RoiShape;
 
-
 // A trajectory with the id it is published under (0: the configured file's).
 struct ActiveTrajectory {
   roi::Trajectory trajectory;

@@ -53,6 +53,8 @@ class ScenarioRun {
   [[nodiscard]] const std::vector<std::uint8_t>& labels() const noexcept { return labels_; }
   [[nodiscard]] const Eigen::Isometry3d& robot_from_lidar() const noexcept { return robot_from_lidar_; }
   // The decoder's options, as the daemon's configuration for this run sets them.
+  // What the daemon decodes this run with: the configured calibration and options.
+  [[nodiscard]] vlp16::Calibration calibration() const { return pipeline::load_calibration(config_); }
   [[nodiscard]] vlp16::StreamOptions stream_options() const;
   // The daemon's configuration for this run (its trajroid.yaml), with the evaluation's ROI:
   // `shape` at `ratio_pct` % of its size along the trajectory, the scenario's look-ahead, and
