@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "trajroi/host/clock.hpp"
+
 namespace trajroi::daemon::log {
 namespace {
 
@@ -71,6 +73,16 @@ bool RateLimited::allow(std::int64_t now_ns, std::uint64_t& suppressed) noexcept
   }
   suppressed = held_.exchange(0, std::memory_order_relaxed);
   return true;
+}
+
+void warn_limited(RateLimited& limit, const std::string& message) {
+  std::uint64_t suppressed = 0;
+  if (!limit.allow(host::monotonic_ns(), suppressed)) return;
+  if (suppressed > 0) {
+    warn("{} ({} similar warnings suppressed)", message, suppressed);
+  } else {
+    warn("{}", message);
+  }
 }
 
 }  // namespace trajroi::daemon::log

@@ -39,4 +39,7 @@ class RateLimited {
   std::atomic<std::uint64_t> held_{0};
 };
 
+// A warning through `limit`: at most one per its interval, with the count held back since.
+void warn_limited(RateLimited& limit, const std::string& message);
+
 }  // namespace trajroi::daemon::log

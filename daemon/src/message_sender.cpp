@@ -1,0 +1,32 @@
+#include "message_sender.hpp"
+
+namespace trajroi::daemon {
+
+MessageSender::MessageSender(Outlet& outlet, const DaemonConfig& config) : outlet_(outlet), config_(config) {}
+
+void MessageSender::make_resident() {
+  // A page over for the head, whose size is that of an empty sweep's.
+  daemon::encode_points(pipeline::Sweep{}, config_.pose_mode, points_, points_encoded_);
+  points_encoded_.resize(points_encoded_.size() + 4096 + config_.buffers.max_points_per_sweep * kEncodedBytesPerPoint);
+  points_encoded_.clear();
+}
+
+void MessageSender::send_pose(const pipeline::Sweep& s) {
+  fill_pose(s, pose_);
+  send(config_.lcm.pose, pose_);
+}
+
+void MessageSender::send_roi(const pipeline::Sweep& s) {
+  fill_roi(s, roi_);
+  send(config_.lcm.roi, roi_);
+}
+
+void MessageSender::encode_points(const pipeline::Sweep& s) {
+  daemon::encode_points(s, config_.pose_mode, points_, points_encoded_);
+}
+
+void MessageSender::send_points() {
+  outlet_.publish(config_.lcm.points, points_encoded_);
+}
+
+}  // namespace trajroi::daemon
