@@ -29,9 +29,10 @@ void MinuteLine::on_status(const StatusSnapshot& s, LatencyBook& latency) {
 void MinuteLine::write(const StatusSnapshot& s, LatencyBook& latency) {
   // A late maximum says where its time went (an as-fast replay's queue is not lateness).
   const SweepTiming& slowest_sweep = latency.slowest_in_minute();
-  const std::string slowest = slowest_sweep.total_ms > kLateSweep_ms && latency.describes_late()
-                                  ? fmt::format(" | slowest: sweep {} {}", slowest_sweep.index, slowest_sweep.describe())
-                                  : std::string();
+  const std::string slowest =
+      slowest_sweep.total_ms > kLateSweep_ms && latency.describes_late()
+          ? fmt::format(" | slowest: sweep {} {}", slowest_sweep.index, slowest_sweep.describe())
+          : std::string();
   log::info(
       "minute: {:.0f} s | sweeps {} published {} | latency p50 {:.2f} p99 {:.2f} max {:.2f} ms | ring drops {} | "
       "kernel drops {} | lost packets {} | RSS {:.1f} MiB{}",

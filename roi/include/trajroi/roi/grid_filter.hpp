@@ -144,9 +144,10 @@ class GridFilter {
   // Bit k set for each lane k of `boundary` whose point first + k is kept, given the indices
   // of the lanes' sub-cells in sub_. Inlined into each scan, so that it is compiled for the
   // scan's instruction set.
-  [[nodiscard]] __attribute__((always_inline)) unsigned decide_lanes(unsigned boundary, const std::uint32_t* sub_index,
-                                                                     std::span<const PointXYZI> points,
-                                                                     std::size_t first) const;
+  [[nodiscard]] __attribute__((always_inline)) inline unsigned decide_lanes(unsigned boundary,
+                                                                            const std::uint32_t* sub_index,
+                                                                            std::span<const PointXYZI> points,
+                                                                            std::size_t first) const;
   // decide_lanes for the AVX2 scan: out of line (inlined, the scan's loop reloaded its
   // constants from the stack: 16 ymm registers are few), compiled for AVX2 (so that no SSE
   // code runs with the upper vector state dirty).
