@@ -221,14 +221,14 @@ __attribute__((target("avx2,popcnt"))) std::size_t GridFilter<RoiSet>::scan_avx2
   return i;
 }
 
-template unsigned GridFilter<CircularRoiSet>::decide_lanes_avx2(unsigned, const std::uint32_t*, std::span<const PointXYZI>,
-                                                       std::size_t) const;
+template unsigned GridFilter<CircularRoiSet>::decide_lanes_avx2(unsigned, const std::uint32_t*,
+                                                                std::span<const PointXYZI>, std::size_t) const;
 template std::size_t GridFilter<CircularRoiSet>::scan_avx2(std::span<const PointXYZI>, Scan&) const;
-template unsigned GridFilter<RectangularRoiSet>::decide_lanes_avx2(unsigned, const std::uint32_t*, std::span<const PointXYZI>,
-                                                       std::size_t) const;
+template unsigned GridFilter<RectangularRoiSet>::decide_lanes_avx2(unsigned, const std::uint32_t*,
+                                                                   std::span<const PointXYZI>, std::size_t) const;
 template std::size_t GridFilter<RectangularRoiSet>::scan_avx2(std::span<const PointXYZI>, Scan&) const;
-template unsigned GridFilter<CorridorRoiSet>::decide_lanes_avx2(unsigned, const std::uint32_t*, std::span<const PointXYZI>,
-                                                       std::size_t) const;
+template unsigned GridFilter<CorridorRoiSet>::decide_lanes_avx2(unsigned, const std::uint32_t*,
+                                                                std::span<const PointXYZI>, std::size_t) const;
 template std::size_t GridFilter<CorridorRoiSet>::scan_avx2(std::span<const PointXYZI>, Scan&) const;
 #endif  // x86
 

@@ -1,7 +1,5 @@
 // A scenario run folder as the evaluations read it (ScenarioRun), the daemon's pipeline run
 // over it (run_pipelines), the evaluation's ROI chains and the true placement of a frame.
-#include "trajroi/eval/scenario_eval.hpp"
-
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -12,6 +10,7 @@
 
 #include "timing.hpp"
 #include "trajroi/config/text_file.hpp"
+#include "trajroi/eval/scenario_eval.hpp"
 #include "trajroi/inputs/capture.hpp"
 #include "trajroi/inputs/run_merger.hpp"
 #include "trajroi/pipeline/sweep_processor.hpp"
@@ -197,6 +196,5 @@ void place_frame_truth(const vlp16::Frame& frame, const sim::TruthPoses& truth,
     out.push_back({g.x(), g.y(), g.z()});
   }
 }
-
 
 }  // namespace trajroi::eval
