@@ -1,4 +1,4 @@
-// trajroid — the trajectory-ROI daemon. See daemon/README.md and config/trajroid.yaml.
+// trajroid — the trajectory-ROI daemon. See docs/daemon.md and docs/configuration.md.
 #include <spawn.h>
 #include <sys/wait.h>
 

@@ -45,7 +45,7 @@ std::unique_ptr<Outlet> make_outlet(const std::string& url);
 // receive socket (UdpmReceiver, opened by subscribe()) carries a kernel filter that drops the
 // datagrams of its own send socket: through liblcm, the daemon read back every cloud it
 // published (an as-fast corridor replay: 20 ms of a thread's CPU, 15 % of the process's with
-// the dearer sends; README "LCM without reading itself back").
+// the dearer sends; docs/lcm.md, "LCM without reading itself back").
 class UdpmOutlet final : public Outlet {
  public:
   // Opens the send socket and probes (up to 0.5 s) that its multicast comes back. Throws

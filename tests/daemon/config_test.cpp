@@ -216,3 +216,32 @@ TEST(DaemonConfig, TheDaemonExitsWith78OnABadConfigurationAndCheckConfigPassesAG
 }
 
 }  // namespace
+
+namespace {
+
+// The keys of a `key: value` line each, in order (describe()'s output).
+std::vector<std::string> described_keys(const DaemonConfig& c) {
+  std::vector<std::string> keys;
+  std::istringstream lines(describe(c));
+  for (std::string line; std::getline(lines, line);)
+    keys.push_back(line.substr(0, line.find(':')));
+  return keys;
+}
+
+// The reference page (docs/configuration.md) lists, in its tables' first column, exactly the
+// keys the daemon reads and reports, in the same order.
+TEST(Config, TheReferencePageListsEveryKeyTheDaemonReads) {
+  const std::vector<std::string> expected =
+      described_keys(parse_daemon_config(example(), fs::path(TRAJROI_EXAMPLE_CONFIG)));
+  ASSERT_GT(expected.size(), 60u);
+  std::vector<std::string> documented;
+  std::istringstream page(daemon_test::slurp(TRAJROI_CONFIG_DOC));
+  for (std::string line; std::getline(page, line);) {
+    if (line.rfind("| `", 0) != 0) continue;
+    const std::size_t end = line.find('`', 3);
+    documented.push_back(line.substr(3, end - 3));
+  }
+  EXPECT_EQ(documented, expected);
+}
+
+}  // namespace

@@ -35,7 +35,7 @@ done <"$build/install_manifest.txt"
 [ ! -e /opt/trajroi-destdir-test ] || fail "DESTDIR: files written to /opt/trajroi-destdir-test"
 echo "DESTDIR=… cmake --install: $(wc -l <"$build/install_manifest.txt") files, all staged, none outside"
 
-# The subscribers of the README, on the installed package.
+# The subscribers of docs/lcm.md, on the installed package.
 cmake -S "$prefix/share/doc/trajroi/examples" -B "$work/subscriber" -DCMAKE_PREFIX_PATH="$prefix" >"$work/cmake.txt" 2>&1 ||
   fail "the example does not configure against the installed package: $(tail -20 "$work/cmake.txt")"
 cmake --build "$work/subscriber" >>"$work/cmake.txt" 2>&1 || fail "the example does not build: $(tail -20 "$work/cmake.txt")"
