@@ -66,8 +66,10 @@ int main(int argc, char** argv) {
   std::string config_file;
   std::string replay, record, rate = "max", lcm_url;
   std::string apply_unit;
-  bool check_config = false, loop = false, print_drop_in = false;
-  app.add_option("--config", config_file, "YAML configuration (see config/trajroid.yaml)")->required();
+  bool check_config = false, loop = false, print_drop_in = false, print_reference = false;
+  app.add_option("--config", config_file, "YAML configuration (see config/trajroid.yaml)");
+  app.add_flag("--config-reference", print_reference,
+               "Print every configuration key with its type, default and meaning (Markdown), and exit");
   app.add_option("--replay", replay, "Replay a run folder (lidar.pcap, gnss.trjb, imu.trjb) instead of the sensors");
   app.add_option("--rate", rate, "Replay pace: realtime, max, or a factor of real time (e.g. 10)")
       ->capture_default_str();
@@ -86,6 +88,11 @@ int main(int argc, char** argv) {
       ->group("Testing");
   try {
     app.parse(argc, argv);
+    if (print_reference) {
+      std::printf("%s", config_reference().c_str());
+      return 0;
+    }
+    if (config_file.empty()) throw CLI::RequiredError("--config");
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }

@@ -219,29 +219,26 @@ TEST(DaemonConfig, TheDaemonExitsWith78OnABadConfigurationAndCheckConfigPassesAG
 
 namespace {
 
-// The keys of a `key: value` line each, in order (describe()'s output).
-std::vector<std::string> described_keys(const DaemonConfig& c) {
-  std::vector<std::string> keys;
-  std::istringstream lines(describe(c));
-  for (std::string line; std::getline(lines, line);)
-    keys.push_back(line.substr(0, line.find(':')));
-  return keys;
-}
+// The reference page (docs/configuration.md) holds, below its marker, exactly what the daemon's
+// key table generates; and that table's keys are the ones --check-config reports.
+TEST(Config, TheReferencePageIsTheDaemonsOwnTable) {
+  const std::string page = daemon_test::slurp(TRAJROI_CONFIG_DOC);
+  const std::string marker = "<!-- generated: trajroid --config-reference -->\n";
+  const std::size_t at = page.find(marker);
+  ASSERT_NE(at, std::string::npos) << "docs/configuration.md has no generated part";
+  EXPECT_EQ(page.substr(at + marker.size()), config_reference())
+      << "regenerate it: trajroid --config-reference (below the marker)";
 
-// The reference page (docs/configuration.md) lists, in its tables' first column, exactly the
-// keys the daemon reads and reports, in the same order.
-TEST(Config, TheReferencePageListsEveryKeyTheDaemonReads) {
-  const std::vector<std::string> expected =
-      described_keys(parse_daemon_config(example(), fs::path(TRAJROI_EXAMPLE_CONFIG)));
-  ASSERT_GT(expected.size(), 60u);
-  std::vector<std::string> documented;
-  std::istringstream page(daemon_test::slurp(TRAJROI_CONFIG_DOC));
-  for (std::string line; std::getline(page, line);) {
-    if (line.rfind("| `", 0) != 0) continue;
-    const std::size_t end = line.find('`', 3);
-    documented.push_back(line.substr(3, end - 3));
+  std::vector<std::string> described, referenced;
+  std::istringstream lines(describe(parse_daemon_config(example(), fs::path(TRAJROI_EXAMPLE_CONFIG))));
+  for (std::string line; std::getline(lines, line);)
+    described.push_back(line.substr(0, line.find(':')));
+  std::istringstream rows(config_reference());
+  for (std::string line; std::getline(rows, line);) {
+    if (line.rfind("| `", 0) == 0) referenced.push_back(line.substr(3, line.find('`', 3) - 3));
   }
-  EXPECT_EQ(documented, expected);
+  EXPECT_GT(described.size(), 60u);
+  EXPECT_EQ(referenced, described);
 }
 
 }  // namespace

@@ -170,6 +170,11 @@ struct LcmGroup {
 // the code's through it).
 [[nodiscard]] std::string describe(const DaemonConfig& config);
 
+// The reference of every key, as Markdown: one table per section (key, type, default,
+// meaning), generated from the same table the parse and describe() walk (docs/configuration.md
+// holds it; `trajroid --config-reference` prints it).
+[[nodiscard]] std::string config_reference();
+
 // Reads and checks a configuration. Throws config::ConfigError.
 [[nodiscard]] DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::path& file);
 [[nodiscard]] DaemonConfig load_daemon_config(const std::filesystem::path& file);
