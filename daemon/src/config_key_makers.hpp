@@ -39,7 +39,10 @@ enum class Sign { kAny, kPositive, kNonNegative };
 // lambda that works on a const DaemonConfig too).
 template <typename Get>
 inline ConfigKey count_key(std::string_view path, std::string_view meaning, std::size_t lo, std::size_t hi, Get get) {
-  return {path, "integer", meaning, false,
+  return {path,
+          "integer",
+          meaning,
+          false,
           [lo, hi, get](MapReader& m, std::string_view k, DaemonConfig& c, const Dir&) {
             std::size_t& v = get(c);
             v = count(m, k, v, lo, hi);
@@ -50,11 +53,15 @@ inline ConfigKey count_key(std::string_view path, std::string_view meaning, std:
 // A number held in a double of DaemonConfig (reached by `get`), checked by `sign`.
 template <typename Get>
 ConfigKey real_key(std::string_view path, std::string_view type, std::string_view meaning, Sign sign, Get get) {
-  return {path, type, meaning, false,
+  return {path,
+          type,
+          meaning,
+          false,
           [sign, get](MapReader& m, std::string_view k, DaemonConfig& c, const Dir&) {
             double& v = get(c);
-            v = sign == Sign::kPositive ? m.positive(k, v) : sign == Sign::kNonNegative ? m.non_negative(k, v)
-                                                                                         : m.number(k, v);
+            v = sign == Sign::kPositive      ? m.positive(k, v)
+                : sign == Sign::kNonNegative ? m.non_negative(k, v)
+                                             : m.number(k, v);
           },
           [get](const DaemonConfig& c) { return format_number(get(c)); }};
 }
@@ -62,7 +69,10 @@ ConfigKey real_key(std::string_view path, std::string_view type, std::string_vie
 // A boolean held in DaemonConfig (reached by `get`).
 template <typename Get>
 ConfigKey flag_key(std::string_view path, std::string_view meaning, Get get) {
-  return {path, "boolean", meaning, false,
+  return {path,
+          "boolean",
+          meaning,
+          false,
           [get](MapReader& m, std::string_view k, DaemonConfig& c, const Dir&) {
             bool& v = get(c);
             v = m.boolean(k, v);

@@ -16,7 +16,10 @@ using namespace config_keys_detail;
 
 // A lcm.channels.* key.
 ConfigKey channel_key(std::string_view path, std::string_view meaning, std::string DaemonConfig::Lcm::*name) {
-  return {path, "text", meaning, false,
+  return {path,
+          "text",
+          meaning,
+          false,
           [name](MapReader& m, std::string_view k, DaemonConfig& c, const Dir&) {
             c.lcm.*name = m.text(k, c.lcm.*name);
             m.require(!(c.lcm.*name).empty(), k, "must not be empty");
@@ -26,7 +29,10 @@ ConfigKey channel_key(std::string_view path, std::string_view meaning, std::stri
 
 // A realtime.threads.* key.
 ConfigKey thread_key(std::string_view path, std::string_view meaning, ThreadConfig DaemonConfig::Realtime::*thread) {
-  return {path, "{policy: other | fifo | rr, priority: 1–99, cpus: [..]}", meaning, false,
+  return {path,
+          "{policy: other | fifo | rr, priority: 1–99, cpus: [..]}",
+          meaning,
+          false,
           [thread](MapReader& m, std::string_view k, DaemonConfig& c, const Dir&) {
             c.realtime.*thread = read_thread(m, k);
           },
@@ -50,12 +56,14 @@ std::vector<ConfigKey> make_keys() {
                                                 : PoseSource::kGnssImu;
                },
                [](const DaemonConfig& c) { return std::string(to_string(c.pose_source)); }});
-  k.push_back(real_key("pose.gnss_heading.min_speed_mps", "number > 0",
-                       "source gnss: the course over ground is a heading only above this speed …", Sign::kPositive,
-                       [](auto& c) -> auto& { return c.gnss_heading.min_speed_mps; }));
-  k.push_back(real_key("pose.gnss_heading.max_heading_acc_deg", "number > 0",
-                       "… and with its accuracy (headAcc / accHeading) at most this; otherwise the last heading is held",
-                       Sign::kPositive, [](auto& c) -> auto& { return c.gnss_heading.max_heading_acc_deg; }));
+  k.push_back(real_key(
+      "pose.gnss_heading.min_speed_mps", "number > 0",
+      "source gnss: the course over ground is a heading only above this speed …", Sign::kPositive,
+      [](auto& c) -> auto& { return c.gnss_heading.min_speed_mps; }));
+  k.push_back(real_key(
+      "pose.gnss_heading.max_heading_acc_deg", "number > 0",
+      "… and with its accuracy (headAcc / accHeading) at most this; otherwise the last heading is held",
+      Sign::kPositive, [](auto& c) -> auto& { return c.gnss_heading.max_heading_acc_deg; }));
   k.push_back({"pose.gnss_heading.baseline_yaw_deg", "number in [-180, 180]",
                "moving base → rover antenna direction in the robot frame (0: rear → front)", false,
                [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
@@ -100,30 +108,35 @@ std::vector<ConfigKey> make_keys() {
                  c.gate.min_fix_type = static_cast<std::uint8_t>(count(m, key, c.gate.min_fix_type, 1, 5));
                },
                [](const DaemonConfig& c) { return format_number(c.gate.min_fix_type); }});
-  k.push_back(flag_key("pose.require_gnss_fix_ok", "gate: NAV-PVT's gnssFixOK flag set",
-                       [](auto& c) -> auto& { return c.gate.require_gnss_fix_ok; }));
-  k.push_back(real_key("pose.max_h_acc_m", "number > 0",
-                       "gate: horizontal accuracy estimate at most this (a standalone receiver reports 1–3 m; 0.05 "
-                       "insists on RTK-grade fixes)",
-                       Sign::kPositive, [](auto& c) -> auto& { return c.gate.max_h_acc_m; }));
-  k.push_back(flag_key("pose.require_rtk_fixed", "gate: only an RTK fixed carrier solution",
-                       [](auto& c) -> auto& { return c.gate.require_rtk_fixed; }));
-  k.push_back({"pose.max_extrapolation_s", "number ≥ 0",
-               "gate: past the newest fix / attitude (a GNSS period + its delay: 0.5 covers 4 Hz and faster; a 1 Hz "
-               "receiver needs 1.2)",
-               false,
-               [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
-                 c.gate.max_extrapolation_ns = std::llround(
-                     m.non_negative(key, static_cast<double>(c.gate.max_extrapolation_ns) * 1e-9) * 1e9);
-               },
-               [](const DaemonConfig& c) { return format_number(static_cast<double>(c.gate.max_extrapolation_ns) * 1e-9); }});
+  k.push_back(flag_key(
+      "pose.require_gnss_fix_ok", "gate: NAV-PVT's gnssFixOK flag set",
+      [](auto& c) -> auto& { return c.gate.require_gnss_fix_ok; }));
+  k.push_back(real_key(
+      "pose.max_h_acc_m", "number > 0",
+      "gate: horizontal accuracy estimate at most this (a standalone receiver reports 1–3 m; 0.05 "
+      "insists on RTK-grade fixes)",
+      Sign::kPositive, [](auto& c) -> auto& { return c.gate.max_h_acc_m; }));
+  k.push_back(flag_key(
+      "pose.require_rtk_fixed", "gate: only an RTK fixed carrier solution",
+      [](auto& c) -> auto& { return c.gate.require_rtk_fixed; }));
+  k.push_back(
+      {"pose.max_extrapolation_s", "number ≥ 0",
+       "gate: past the newest fix / attitude (a GNSS period + its delay: 0.5 covers 4 Hz and faster; a 1 Hz "
+       "receiver needs 1.2)",
+       false,
+       [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
+         c.gate.max_extrapolation_ns =
+             std::llround(m.non_negative(key, static_cast<double>(c.gate.max_extrapolation_ns) * 1e-9) * 1e9);
+       },
+       [](const DaemonConfig& c) { return format_number(static_cast<double>(c.gate.max_extrapolation_ns) * 1e-9); }});
   k.push_back({"pose.max_gap_s", "number > 0", "gate: at most this between the two samples around a firing", false,
                [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
                  c.gate.max_gap_ns = std::llround(m.positive(key, static_cast<double>(c.gate.max_gap_ns) * 1e-9) * 1e9);
                },
                [](const DaemonConfig& c) { return format_number(static_cast<double>(c.gate.max_gap_ns) * 1e-9); }});
-  k.push_back(count_key("pose.buffer_samples", "samples kept per stream", 16, std::size_t{1} << 20,
-                        [](auto& c) -> auto& { return c.pose_capacity; }));
+  k.push_back(count_key(
+      "pose.buffer_samples", "samples kept per stream", 16, std::size_t{1} << 20,
+      [](auto& c) -> auto& { return c.pose_capacity; }));
   // ---- roi
   k.push_back({"roi.shape", "circular | rectangular", "the shape laid along the trajectory", false,
                [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
@@ -131,16 +144,21 @@ std::vector<ConfigKey> make_keys() {
                  c.roi.shape = s == "rectangular" ? RoiShape::kRectangular : RoiShape::kCircular;
                },
                [](const DaemonConfig& c) { return std::string(roi::to_string(c.roi.shape)); }});
-  k.push_back(real_key("roi.circle_diameter_m", "number > 0", "2r", Sign::kPositive,
-                       [](auto& c) -> auto& { return c.roi.circle_diameter_m; }));
-  k.push_back(real_key("roi.rect_height_m", "number > 0", "a, along the trajectory", Sign::kPositive,
-                       [](auto& c) -> auto& { return c.roi.rect_height_m; }));
-  k.push_back(real_key("roi.rect_width_m", "number > 0", "b, across the trajectory", Sign::kPositive,
-                       [](auto& c) -> auto& { return c.roi.rect_width_m; }));
-  k.push_back(real_key("roi.spacing_ratio", "number > 0", "d as a fraction of 2r (circles) or a (rectangles)",
-                       Sign::kPositive, [](auto& c) -> auto& { return c.roi.spacing_ratio; }));
-  k.push_back(real_key("roi.look_ahead_m", "number ≥ 0", "the chain's length ahead of the robot", Sign::kNonNegative,
-                       [](auto& c) -> auto& { return c.roi.look_ahead_m; }));
+  k.push_back(real_key(
+      "roi.circle_diameter_m", "number > 0", "2r", Sign::kPositive,
+      [](auto& c) -> auto& { return c.roi.circle_diameter_m; }));
+  k.push_back(real_key(
+      "roi.rect_height_m", "number > 0", "a, along the trajectory", Sign::kPositive,
+      [](auto& c) -> auto& { return c.roi.rect_height_m; }));
+  k.push_back(real_key(
+      "roi.rect_width_m", "number > 0", "b, across the trajectory", Sign::kPositive,
+      [](auto& c) -> auto& { return c.roi.rect_width_m; }));
+  k.push_back(real_key(
+      "roi.spacing_ratio", "number > 0", "d as a fraction of 2r (circles) or a (rectangles)", Sign::kPositive,
+      [](auto& c) -> auto& { return c.roi.spacing_ratio; }));
+  k.push_back(real_key(
+      "roi.look_ahead_m", "number ≥ 0", "the chain's length ahead of the robot", Sign::kNonNegative,
+      [](auto& c) -> auto& { return c.roi.look_ahead_m; }));
   k.push_back({"roi.z_min_m", "number or none", "lower height limit (global frame, m, inclusive; none: no limit)",
                false,
                [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
@@ -153,15 +171,17 @@ std::vector<ConfigKey> make_keys() {
                  c.roi.z_max_m = optional_number(m, key).value_or(std::numeric_limits<double>::infinity());
                },
                [](const DaemonConfig& c) { return format_number(c.roi.z_max_m); }});
-  k.push_back(real_key("roi.speed_scaling.look_ahead_s", "number ≥ 0", "the look-ahead grows by speed × this",
-                       Sign::kNonNegative, [](auto& c) -> auto& { return c.roi.look_ahead_per_mps_s; }));
-  k.push_back(real_key("roi.speed_scaling.width_s", "number ≥ 0",
-                       "the diameter / rectangle width grows by speed × this", Sign::kNonNegative,
-                       [](auto& c) -> auto& { return c.roi.width_per_mps_s; }));
-  k.push_back(real_key("roi.speed_scaling.max_speed_mps", "number > 0",
-                       "the speed used above is capped here; an unknown speed (a pose valid for < 0.1 s) grows the "
-                       "ROI as this cap does",
-                       Sign::kPositive, [](auto& c) -> auto& { return c.roi.max_speed_mps; }));
+  k.push_back(real_key(
+      "roi.speed_scaling.look_ahead_s", "number ≥ 0", "the look-ahead grows by speed × this", Sign::kNonNegative,
+      [](auto& c) -> auto& { return c.roi.look_ahead_per_mps_s; }));
+  k.push_back(real_key(
+      "roi.speed_scaling.width_s", "number ≥ 0", "the diameter / rectangle width grows by speed × this",
+      Sign::kNonNegative, [](auto& c) -> auto& { return c.roi.width_per_mps_s; }));
+  k.push_back(real_key(
+      "roi.speed_scaling.max_speed_mps", "number > 0",
+      "the speed used above is capped here; an unknown speed (a pose valid for < 0.1 s) grows the "
+      "ROI as this cap does",
+      Sign::kPositive, [](auto& c) -> auto& { return c.roi.max_speed_mps; }));
   // ---- lcm
   k.push_back({"lcm.url", "LCM URL (udpm, memq, file, tcpq)", "where the messages go; udpm ttl=0: this host only",
                false,
@@ -174,41 +194,48 @@ std::vector<ConfigKey> make_keys() {
                           &DaemonConfig::Lcm::points));
   k.push_back(channel_key("lcm.channels.pose", "pose_t: each sweep's pose, valid or not (with the reason)",
                           &DaemonConfig::Lcm::pose));
-  k.push_back(channel_key("lcm.channels.roi", "roi_t: the chain each sweep was filtered against", &DaemonConfig::Lcm::roi));
-  k.push_back(channel_key("lcm.channels.status", "status_t: health and counters, once a second",
-                          &DaemonConfig::Lcm::status));
+  k.push_back(
+      channel_key("lcm.channels.roi", "roi_t: the chain each sweep was filtered against", &DaemonConfig::Lcm::roi));
+  k.push_back(
+      channel_key("lcm.channels.status", "status_t: health and counters, once a second", &DaemonConfig::Lcm::status));
   k.push_back(channel_key("lcm.channels.trajectory", "trajectory_t (input): replaces the active trajectory",
                           &DaemonConfig::Lcm::trajectory));
-  k.push_back(channel_key("lcm.channels.pose_input",
-                          "pose_input_t (input, pose.source lcm): the robot's localization",
+  k.push_back(channel_key("lcm.channels.pose_input", "pose_input_t (input, pose.source lcm): the robot's localization",
                           &DaemonConfig::Lcm::pose_input));
   // ---- buffers, time, logging, realtime
-  k.push_back(count_key("buffers.lidar_packets", "ring of the LiDAR input (≈ 2.7 s of dual-return packets)", 16,
-                        std::size_t{1} << 20, [](auto& c) -> auto& { return c.buffers.lidar_packets; }));
-  k.push_back(count_key("buffers.serial_chunks", "ring of each serial input", 16, std::size_t{1} << 20,
-                        [](auto& c) -> auto& { return c.buffers.serial_chunks; }));
-  k.push_back(count_key("buffers.sweeps", "ring of finished sweeps, processing → publisher", 2, 1024,
-                        [](auto& c) -> auto& { return c.buffers.sweeps; }));
-  k.push_back(count_key("buffers.max_points_per_sweep",
-                        "kept points a sweep holds at most (a 5 Hz dual-return sweep has ≈ 115 000 points); more "
-                        "are counted as truncated",
-                        1024, std::size_t{1} << 24,
-                        [](auto& c) -> auto& { return c.buffers.max_points_per_sweep; }));
-  k.push_back(real_key("time.max_gnss_offset_s", "number > 0",
-                       "host UTC − GNSS UTC (NAV-PVT) beyond this is warned: is NTP / chrony running?",
-                       Sign::kPositive, [](auto& c) -> auto& { return c.time.max_gnss_offset_s; }));
+  k.push_back(count_key(
+      "buffers.lidar_packets", "ring of the LiDAR input (≈ 2.7 s of dual-return packets)", 16, std::size_t{1} << 20,
+      [](auto& c) -> auto& { return c.buffers.lidar_packets; }));
+  k.push_back(count_key(
+      "buffers.serial_chunks", "ring of each serial input", 16, std::size_t{1} << 20,
+      [](auto& c) -> auto& { return c.buffers.serial_chunks; }));
+  k.push_back(count_key(
+      "buffers.sweeps", "ring of finished sweeps, processing → publisher", 2, 1024,
+      [](auto& c) -> auto& { return c.buffers.sweeps; }));
+  k.push_back(count_key(
+      "buffers.max_points_per_sweep",
+      "kept points a sweep holds at most (a 5 Hz dual-return sweep has ≈ 115 000 points); more "
+      "are counted as truncated",
+      1024, std::size_t{1} << 24, [](auto& c) -> auto& { return c.buffers.max_points_per_sweep; }));
+  k.push_back(real_key(
+      "time.max_gnss_offset_s", "number > 0",
+      "host UTC − GNSS UTC (NAV-PVT) beyond this is warned: is NTP / chrony running?", Sign::kPositive,
+      [](auto& c) -> auto& { return c.time.max_gnss_offset_s; }));
   k.push_back({"logging.level", "trace | debug | info | warn | error | critical | off", "the log's level", false,
                [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
                  c.logging.level =
                      m.choice(key, {"trace", "debug", "info", "warn", "error", "critical", "off"}, c.logging.level);
                },
                [](const DaemonConfig& c) { return c.logging.level; }});
-  k.push_back(real_key("logging.warning_interval_s", "number ≥ 0",
-                       "warnings that can fire per packet: at most one per interval and kind", Sign::kNonNegative,
-                       [](auto& c) -> auto& { return c.logging.warning_interval_s; }));
-  k.push_back(flag_key("realtime.lock_memory", "mlockall; needs CAP_IPC_LOCK or LimitMEMLOCK (systemd/realtime.conf)",
-                       [](auto& c) -> auto& { return c.realtime.lock_memory; }));
-  k.push_back(thread_key("realtime.threads.lidar", "the LiDAR input thread, e.g. {policy: fifo, priority: 60, cpus: [1]}",
+  k.push_back(real_key(
+      "logging.warning_interval_s", "number ≥ 0",
+      "warnings that can fire per packet: at most one per interval and kind", Sign::kNonNegative,
+      [](auto& c) -> auto& { return c.logging.warning_interval_s; }));
+  k.push_back(flag_key(
+      "realtime.lock_memory", "mlockall; needs CAP_IPC_LOCK or LimitMEMLOCK (systemd/realtime.conf)",
+      [](auto& c) -> auto& { return c.realtime.lock_memory; }));
+  k.push_back(thread_key("realtime.threads.lidar",
+                         "the LiDAR input thread, e.g. {policy: fifo, priority: 60, cpus: [1]}",
                          &DaemonConfig::Realtime::lidar));
   k.push_back(thread_key("realtime.threads.gnss", "the GNSS input thread", &DaemonConfig::Realtime::gnss));
   k.push_back(thread_key("realtime.threads.imu", "the IMU input thread", &DaemonConfig::Realtime::imu));
@@ -225,19 +252,22 @@ std::vector<ConfigSection> make_sections() {
   std::vector<ConfigSection> s;
   s.push_back({"global_frame", "The global frame", "ENU (x east, y north, z up) about an origin. Required.", true, {}});
   s.push_back({"trajectory", "The trajectory", "The active trajectory at start. Required.", true, {}});
-  s.push_back({"lidar", "The LiDAR", "A Velodyne VLP-16 on UDP.", false,
-               [](MapReader& m, const DaemonConfig& c) {
+  s.push_back({"lidar", "The LiDAR", "A Velodyne VLP-16 on UDP.", false, [](MapReader& m, const DaemonConfig& c) {
                  m.require(c.lidar.max_range_m > c.lidar.min_range_m, "max_range_m", "must exceed min_range_m");
                }});
-  s.push_back({"gnss", "The GNSS receiver", "A u-blox receiver on a serial port: UBX NAV-PVT (+ NAV-HPPOSLLH) at 5–10 Hz.",
-               false, {}});
-  s.push_back({"imu", "The IMU",
+  s.push_back({"gnss",
+               "The GNSS receiver",
+               "A u-blox receiver on a serial port: UBX NAV-PVT (+ NAV-HPPOSLLH) at 5–10 Hz.",
+               false,
+               {}});
+  s.push_back({"imu",
+               "The IMU",
                "A VectorNav VN-100 on a serial port, binary output: YawPitchRoll, Quaternion or DCM (with TimeStartup "
                "or TimeGps when present; else the receive time).",
-               false, {}});
-  s.push_back({"pose", "The pose", "Where the pose comes from, and the gate a sweep's pose must pass to be published.",
                false,
-               [](MapReader& m, const DaemonConfig& c) {
+               {}});
+  s.push_back({"pose", "The pose", "Where the pose comes from, and the gate a sweep's pose must pass to be published.",
+               false, [](MapReader& m, const DaemonConfig& c) {
                  m.require(c.pose_source != PoseSource::kFixed || m.has("fixed"), "fixed",
                            "must be given with source: fixed ({xyz: [x, y, z], yaw_deg: …})");
                }});
@@ -249,14 +279,20 @@ std::vector<ConfigSection> make_sections() {
                            "gives more than 100000 centres over the look-ahead");
                }});
   s.push_back({"lcm", "LCM", "Where the messages are published and read.", false, {}});
-  s.push_back({"buffers", "Buffers",
-               "Preallocated (and, live, resident) at start; a full ring drops the newest item (counted).", false, {}});
-  s.push_back({"time", "Time",
+  s.push_back({"buffers",
+               "Buffers",
+               "Preallocated (and, live, resident) at start; a full ring drops the newest item (counted).",
+               false,
+               {}});
+  s.push_back({"time",
+               "Time",
                "Published stamps are CLOCK_MONOTONIC (t_ns) and UTC (utc_ns) with its source: the VLP-16's PPS-locked "
                "clock when its position packets say so, else the host's CLOCK_REALTIME.",
-               false, {}});
+               false,
+               {}});
   s.push_back({"logging", "Logging", "", false, {}});
-  s.push_back({"realtime", "Real time", "Per thread: the scheduling policy, priority and CPUs; locked memory.", false, {}});
+  s.push_back(
+      {"realtime", "Real time", "Per thread: the scheduling policy, priority and CPUs; locked memory.", false, {}});
   return s;
 }
 

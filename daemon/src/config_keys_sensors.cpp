@@ -15,28 +15,26 @@ namespace {
 void add_serial_keys(std::vector<ConfigKey>& keys, DaemonConfig::Serial DaemonConfig::*port_of, bool gnss) {
   const auto at = [port_of](DaemonConfig& c) -> DaemonConfig::Serial& { return c.*port_of; };
   const auto of = [port_of](const DaemonConfig& c) -> const DaemonConfig::Serial& { return c.*port_of; };
-  keys.push_back({gnss ? "gnss.device" : "imu.device", "path",
-                  gnss ? "e.g. /dev/ttyACM0 or a udev link /dev/gnss; empty: no GNSS"
-                       : "e.g. /dev/ttyUSB0; empty: no IMU",
-                  false,
-                  [at](MapReader& m, std::string_view k, DaemonConfig& c, const Dir&) {
-                    DaemonConfig::Serial& s = at(c);
-                    s.device = m.text(k, s.device);
-                    // A device that does not exist yet is no configuration error (a USB receiver
-                    // can appear after the daemon starts: a run-time fault, said and retried); one
-                    // that exists must be a terminal or serial device.
-                    struct stat st {};
-                    m.require(s.device.empty() || ::stat(s.device.c_str(), &st) != 0 || S_ISCHR(st.st_mode), k,
-                              "exists but is not a character device (a serial port or pseudo-terminal)");
-                  },
-                  [of](const DaemonConfig& c) { return of(c).device; }});
+  keys.push_back(
+      {gnss ? "gnss.device" : "imu.device", "path",
+       gnss ? "e.g. /dev/ttyACM0 or a udev link /dev/gnss; empty: no GNSS" : "e.g. /dev/ttyUSB0; empty: no IMU", false,
+       [at](MapReader& m, std::string_view k, DaemonConfig& c, const Dir&) {
+         DaemonConfig::Serial& s = at(c);
+         s.device = m.text(k, s.device);
+         // A device that does not exist yet is no configuration error (a USB receiver
+         // can appear after the daemon starts: a run-time fault, said and retried); one
+         // that exists must be a terminal or serial device.
+         struct stat st {};
+         m.require(s.device.empty() || ::stat(s.device.c_str(), &st) != 0 || S_ISCHR(st.st_mode), k,
+                   "exists but is not a character device (a serial port or pseudo-terminal)");
+       },
+       [of](const DaemonConfig& c) { return of(c).device; }});
   keys.push_back({gnss ? "gnss.baud" : "imu.baud", "integer, a standard rate",
                   "the port's baud rate (a wrong rate shows as bytes that frame nothing)", false,
                   [at](MapReader& m, std::string_view k, DaemonConfig& c, const Dir&) {
                     DaemonConfig::Serial& s = at(c);
                     s.baud = static_cast<int>(m.integer(k, s.baud));
-                    m.require(serial::is_supported_baud(s.baud), k,
-                              "must be one of " + serial::supported_bauds_text());
+                    m.require(serial::is_supported_baud(s.baud), k, "must be one of " + serial::supported_bauds_text());
                   },
                   [of](const DaemonConfig& c) { return format_number(of(c).baud); }});
   keys.push_back({gnss ? "gnss.delay_s" : "imu.delay_s", "number in [0, 1)",
@@ -79,18 +77,19 @@ std::string_view coordinates_text(TrajectoryCoordinates t) {
 
 void add_sensor_keys(std::vector<ConfigKey>& k) {
   // ---- global_frame, trajectory
-  k.push_back({"global_frame.origin", "{lat_deg, lon_deg, height_m}",
-               "WGS-84 degrees and ellipsoid height (m): the origin of the global ENU frame", true,
-               [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
-                 const config::Origin o = config::read_origin(m.map(key));
-                 c.origin = pose::Geodetic{o.lat_deg, o.lon_deg, o.height_m};
-               },
-               [](const DaemonConfig& c) {
-                 std::string out("{lat_deg: ");
-                 out.append(format_number(c.origin.lat_deg)).append(", lon_deg: ").append(format_number(c.origin.lon_deg));
-                 out.append(", height_m: ").append(format_number(c.origin.height_m)).append("}");
-                 return out;
-               }});
+  k.push_back(
+      {"global_frame.origin", "{lat_deg, lon_deg, height_m}",
+       "WGS-84 degrees and ellipsoid height (m): the origin of the global ENU frame", true,
+       [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
+         const config::Origin o = config::read_origin(m.map(key));
+         c.origin = pose::Geodetic{o.lat_deg, o.lon_deg, o.height_m};
+       },
+       [](const DaemonConfig& c) {
+         std::string out("{lat_deg: ");
+         out.append(format_number(c.origin.lat_deg)).append(", lon_deg: ").append(format_number(c.origin.lon_deg));
+         out.append(", height_m: ").append(format_number(c.origin.height_m)).append("}");
+         return out;
+       }});
   k.push_back({"trajectory.file", "path",
                "CSV: one waypoint per line; a first line 'x,y' or 'lat,lon' says which (SIGHUP re-reads it)", true,
                [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir& dir) {
@@ -100,16 +99,17 @@ void add_sensor_keys(std::vector<ConfigKey>& k) {
   k.push_back({"trajectory.coordinates", "global_xy | lat_lon",
                "without that first line: global_xy (global frame, m) or lat_lon (WGS-84 degrees)", false,
                [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
-                 c.trajectory_coordinates = m.choice(key, {"global_xy", "lat_lon"},
-                                                     coordinates_text(c.trajectory_coordinates)) == "lat_lon"
-                                                ? TrajectoryCoordinates::kLatLon
-                                                : TrajectoryCoordinates::kGlobalXy;
+                 c.trajectory_coordinates =
+                     m.choice(key, {"global_xy", "lat_lon"}, coordinates_text(c.trajectory_coordinates)) == "lat_lon"
+                         ? TrajectoryCoordinates::kLatLon
+                         : TrajectoryCoordinates::kGlobalXy;
                },
                [](const DaemonConfig& c) { return std::string(coordinates_text(c.trajectory_coordinates)); }});
   // ---- lidar
-  k.push_back({"lidar.model", "VLP-16", "the only model decoded; HDL-32E and VLP-32C packets are rejected (counted)",
-               false, [](MapReader& m, std::string_view key, DaemonConfig&, const Dir&) { (void)m.choice(key, {"VLP-16"}, "VLP-16"); },
-               [](const DaemonConfig&) { return std::string("VLP-16"); }});
+  k.push_back(
+      {"lidar.model", "VLP-16", "the only model decoded; HDL-32E and VLP-32C packets are rejected (counted)", false,
+       [](MapReader& m, std::string_view key, DaemonConfig&, const Dir&) { (void)m.choice(key, {"VLP-16"}, "VLP-16"); },
+       [](const DaemonConfig&) { return std::string("VLP-16"); }});
   k.push_back({"lidar.calibration", "path", "velodyne/nebula calibration YAML; empty: the VLP-16 manual's angles",
                false,
                [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir& dir) {
@@ -122,18 +122,19 @@ void add_sensor_keys(std::vector<ConfigKey>& k) {
                  if (m.has(key)) c.lidar.robot_from_lidar = read_mounting(m.map(key));
                },
                [](const DaemonConfig& c) { return format_mounting(c.lidar.robot_from_lidar); }});
-  k.push_back(real_key("lidar.min_range_m", "number ≥ 0", "returns nearer than this are dropped (e.g. 0.5: the robot itself)",
-                       Sign::kNonNegative, [](auto& c) -> auto& { return c.lidar.min_range_m; }));
-  k.push_back(real_key("lidar.max_range_m", "number > min_range_m",
-                       "returns farther than this are dropped (the VLP-16 reaches 100 m)", Sign::kPositive,
-                       [](auto& c) -> auto& { return c.lidar.max_range_m; }));
-  k.push_back({"lidar.cut_azimuth_deg", "number in [0, 360)", "a sweep starts at this azimuth (0: straight ahead)",
-               false,
-               [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
-                 c.lidar.cut_azimuth_deg = m.number(key, c.lidar.cut_azimuth_deg);
-                 m.require(c.lidar.cut_azimuth_deg >= 0.0 && c.lidar.cut_azimuth_deg < 360.0, key, "must be in [0, 360)");
-               },
-               [](const DaemonConfig& c) { return format_number(c.lidar.cut_azimuth_deg); }});
+  k.push_back(real_key(
+      "lidar.min_range_m", "number ≥ 0", "returns nearer than this are dropped (e.g. 0.5: the robot itself)",
+      Sign::kNonNegative, [](auto& c) -> auto& { return c.lidar.min_range_m; }));
+  k.push_back(real_key(
+      "lidar.max_range_m", "number > min_range_m", "returns farther than this are dropped (the VLP-16 reaches 100 m)",
+      Sign::kPositive, [](auto& c) -> auto& { return c.lidar.max_range_m; }));
+  k.push_back(
+      {"lidar.cut_azimuth_deg", "number in [0, 360)", "a sweep starts at this azimuth (0: straight ahead)", false,
+       [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
+         c.lidar.cut_azimuth_deg = m.number(key, c.lidar.cut_azimuth_deg);
+         m.require(c.lidar.cut_azimuth_deg >= 0.0 && c.lidar.cut_azimuth_deg < 360.0, key, "must be in [0, 360)");
+       },
+       [](const DaemonConfig& c) { return format_number(c.lidar.cut_azimuth_deg); }});
   k.push_back({"lidar.bind_address", "IPv4 address", "the address the UDP sockets bind to", false,
                [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
                  c.lidar.bind_address = ipv4(m, key, c.lidar.bind_address, false);
@@ -165,14 +166,15 @@ void add_sensor_keys(std::vector<ConfigKey>& k) {
                      m, key, static_cast<std::size_t>(c.lidar.receive_buffer_bytes), 65536, std::size_t{1} << 30));
                },
                [](const DaemonConfig& c) { return format_number(c.lidar.receive_buffer_bytes); }});
-  k.push_back(flag_key("lidar.share_ports",
-                       "false: the ports are this daemon's alone (a second reader fails at start, naming the port); "
-                       "true: SO_REUSEADDR, for multicast",
-                       [](auto& c) -> auto& { return c.lidar.share_ports; }));
+  k.push_back(flag_key(
+      "lidar.share_ports",
+      "false: the ports are this daemon's alone (a second reader fails at start, naming the port); "
+      "true: SO_REUSEADDR, for multicast",
+      [](auto& c) -> auto& { return c.lidar.share_ports; }));
   // ---- gnss, imu
   add_serial_keys(k, &DaemonConfig::gnss, true);
-  k.push_back({"gnss.antenna", "[x, y, z]", "the antenna's position in the robot frame, m (lever arm), e.g. [-0.2, 0, 0.9]",
-               false,
+  k.push_back({"gnss.antenna", "[x, y, z]",
+               "the antenna's position in the robot frame, m (lever arm), e.g. [-0.2, 0, 0.9]", false,
                [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
                  const Eigen::Vector3d& d = c.gnss_antenna_m;
                  const auto a = m.numbers(key, {d.x(), d.y(), d.z()});
