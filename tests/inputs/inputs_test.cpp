@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "test_data.hpp"
 #include "trajroi/host/clock.hpp"
 #include "trajroi/inputs/live_input.hpp"
 #include "trajroi/inputs/pacer.hpp"
@@ -232,6 +233,47 @@ TEST(SerialInput, SaysWhenThePortOpensThenHandsItsBytes) {
   EXPECT_EQ(received, sent.size());
   ::close(master);
   ::close(slave);
+}
+
+}  // namespace
+
+namespace {
+
+// Real captures named one by one (what `trajroi feed --pcap --ubx` plays) go through the same
+// merger: the u-blox log in epochs at their iTOW spacing (the neo-m8n log's 24 epochs, 5 Hz),
+// the capture's datagrams at their recorded spacing from `lidar_start_ns`, every byte and every
+// datagram once, in time order.
+TEST(RunMerger, CapturesNamedOneByOneMergeByTheirOwnClocks) {
+  TRAJROI_REQUIRE_DATA(pcap, "velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap");
+  TRAJROI_REQUIRE_DATA(ubx, "ublox/gpsd/ublox-neo-m8n.log");
+  trajroi::inputs::RunFiles files;
+  files.lidar = pcap;
+  files.lidar_start_ns = 1'000'000'000;
+  files.gnss = ubx;
+  files.gnss_options.raw_timing = trajroi::serial::RawTiming::kUbxTime;
+  trajroi::inputs::RunMerger merger(files);
+  InputItem item;
+  std::int64_t previous = INT64_MIN, first_lidar = -1;
+  std::size_t gnss_bytes = 0, lidar = 0;
+  std::vector<std::int64_t> gnss_times;
+  while (merger.next(item)) {
+    EXPECT_GE(item.receive_ns, previous);
+    previous = item.receive_ns;
+    if (item.stream == Stream::kGnss) {
+      gnss_bytes += item.bytes.size();
+      gnss_times.push_back(item.receive_ns);
+    } else {
+      if (first_lidar < 0) first_lidar = item.receive_ns;
+      ++lidar;
+    }
+  }
+  EXPECT_EQ(first_lidar, 1'000'000'000);
+  EXPECT_EQ(lidar, 293u + 57u);  // the data README: 293 data and 57 position packets
+  EXPECT_EQ(gnss_bytes, std::filesystem::file_size(ubx));
+  ASSERT_GE(gnss_times.size(), 24u);
+  EXPECT_EQ(gnss_times.front(), 0);
+  for (std::size_t i = 1; i < 24; ++i)
+    EXPECT_EQ(gnss_times[i] - gnss_times[i - 1], 200'000'000) << "epoch " << i;
 }
 
 }  // namespace

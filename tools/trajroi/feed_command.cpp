@@ -4,46 +4,27 @@
 // unplug a serial device mid-frame and plug it back, flood the UDP port with copies and
 // malformed packets, and send from an address that is not the sensor's. It sends to the
 // loopback interface only.
-#include <arpa/inet.h>
-#include <fcntl.h>
-#include <ifaddrs.h>
-#include <net/if.h>
-#include <netinet/in.h>
-#include <poll.h>
-#include <stdlib.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <memory>
-#include <optional>
 #include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "commands.hpp"
-#include "feed_captures.hpp"
 #include "feed_devices.hpp"
-#include "trajroi/framing/little_endian.hpp"
 #include "trajroi/host/clock.hpp"
 #include "trajroi/inputs/pacer.hpp"
 #include "trajroi/inputs/run_merger.hpp"
-#include "trajroi/ublox/framer.hpp"
-#include "trajroi/ublox/messages.hpp"
 #include "trajroi/vlp16/packet_source.hpp"
-#include "trajroi/vlp16/pcap_source.hpp"
 
 namespace trajroi::cli {
 namespace {
 
 namespace fs = std::filesystem;
 using feed::PtyDevice;
-using feed::TimedChunk;
 using feed::UdpSender;
 
 // "gnss@6+2": the stream's device vanishes 6 s into the data and comes back 2 s later.
@@ -74,12 +55,20 @@ Hangup parse_hangup(const std::string& text) {
   return h;
 }
 
+// Real captures instead of a run folder, each paced by its own clock through the run merger
+// (inputs::RunFiles): a pcap (UDP payloads by their destination port, at their recorded
+// spacing), a raw UBX log (by its epochs' iTOW), a raw VN-100 log (by the LoggerWavesInIce
+// logger's `M,<millis>` markers, or its frames' TimeStartup, else a frame per 0xFA at
+// --vn100-rate).
+struct Captures {
+  std::string pcap, ubx, vn100;  // empty: not fed
+  double lidar_after_s = 0.0;    // the capture's first datagram this long into the serial data
+  double vn100_rate_hz = 10.0;
+};
+
 struct FeedOptions {
   std::string run_dir;
-  // Or real captures, each paced by its own recorded time: a pcap (UDP payloads by their
-  // destination port), a raw UBX log (by the epochs' iTOW), a raw VN-100 log from the
-  // LoggerWavesInIce logger (by its `M,<millis>` markers, else at --vn100-rate).
-  feed::CaptureFiles captures;
+  Captures captures;
   double until_s = 0.0;  // > 0: stop after this much data (a long serial log)
   double rate = 1.0;
   std::uint16_t data_port = vlp16::kDataPort;
@@ -107,31 +96,31 @@ void run_feed(const FeedOptions& o) {
   streams.gnss = !o.gnss_link.empty();
   streams.imu = !o.imu_link.empty();
   std::unique_ptr<inputs::RunMerger> merger;
-  std::vector<TimedChunk> chunks;
-  std::size_t next_chunk = 0;
+  const Captures& c = o.captures;
   if (o.run_dir.empty()) {
-    if (o.captures.pcap.empty() && o.captures.ubx.empty() && o.captures.vn100.empty()) {
+    if (c.pcap.empty() && c.ubx.empty() && c.vn100.empty()) {
       throw std::invalid_argument("feed: give a run folder, or captures (--pcap, --ubx, --vn100)");
     }
-    if (!o.captures.ubx.empty() && !streams.gnss) throw std::invalid_argument("--ubx needs --gnss-link");
-    if (!o.captures.vn100.empty() && !streams.imu) throw std::invalid_argument("--vn100 needs --imu-link");
-    streams.gnss = !o.captures.ubx.empty();
-    streams.imu = !o.captures.vn100.empty();
-    chunks = feed::capture_chunks(o.captures);
+    if (!c.ubx.empty() && !streams.gnss) throw std::invalid_argument("--ubx needs --gnss-link");
+    if (!c.vn100.empty() && !streams.imu) throw std::invalid_argument("--vn100 needs --imu-link");
+    if (!(c.vn100_rate_hz > 0.0)) throw std::invalid_argument("--vn100-rate must be > 0");
+    streams.gnss = !c.ubx.empty();
+    streams.imu = !c.vn100.empty();
+    // The same merger over the captures, each timed by its own clock (serial::RawTiming).
+    inputs::RunFiles files;
+    files.lidar = c.pcap;
+    files.lidar_start_ns = static_cast<std::int64_t>(c.lidar_after_s * 1e9);
+    files.gnss = c.ubx;
+    files.gnss_options.raw_timing = serial::RawTiming::kUbxTime;
+    files.imu = c.vn100;
+    files.imu_options.raw_timing = serial::RawTiming::kVn100Time;
+    files.imu_options.frames_per_second = c.vn100_rate_hz;
+    merger = std::make_unique<inputs::RunMerger>(files);
   } else {
     merger = std::make_unique<inputs::RunMerger>(dir, streams);
     for (const std::string& missing : merger->missing())
       throw std::runtime_error(missing + ": not found");
   }
-  const auto next_item = [&](inputs::InputItem& item) {
-    if (merger) return merger->next(item);
-    if (next_chunk == chunks.size()) return false;
-    const TimedChunk& c = chunks[next_chunk++];
-    item.stream = c.stream;
-    item.bytes = c.bytes;
-    item.receive_ns = c.t_ns;
-    return true;
-  };
   std::unique_ptr<PtyDevice> gnss_dev, imu_dev;
   if (streams.gnss) gnss_dev = std::make_unique<PtyDevice>("gnss", o.gnss_link);
   if (streams.imu) imu_dev = std::make_unique<PtyDevice>("imu", o.imu_link);
@@ -152,8 +141,7 @@ void run_feed(const FeedOptions& o) {
   }
 
   std::int64_t t0 = 0;
-  if (merger ? !merger->peek_time(t0) : chunks.empty()) throw std::runtime_error("feed: nothing to feed");
-  if (!merger) t0 = chunks.front().t_ns;
+  if (!merger->peek_time(t0)) throw std::runtime_error("feed: nothing to feed");
   inputs::Pacer pacer(o.rate);
   const std::int64_t start = host::monotonic_ns();
   double data_s = 0.0;
@@ -166,7 +154,7 @@ void run_feed(const FeedOptions& o) {
   double flood_credit = 0.0;
 
   inputs::InputItem item;
-  while (next_item(item)) {
+  while (merger->next(item)) {
     data_s = static_cast<double>(item.receive_ns - t0) * 1e-9;
     if (o.until_s > 0.0 && data_s > o.until_s) break;
     inputs::Pacer::sleep_until(pacer.due_ns(item.receive_ns));

@@ -162,8 +162,7 @@ class UdpSender {
 };
 
 // One malformed datagram of several kinds, made from a real data packet.
-inline std::vector<std::uint8_t> malformed(std::span<const std::uint8_t> real, std::uint64_t k,
-                                           std::mt19937& random) {
+inline std::vector<std::uint8_t> malformed(std::span<const std::uint8_t> real, std::uint64_t k, std::mt19937& random) {
   std::vector<std::uint8_t> out(real.begin(), real.end());
   out.resize(1206);  // a data packet's size, whatever came in
   switch (k % 5) {

@@ -34,6 +34,22 @@ RunMerger::RunMerger(const fs::path& dir, RunStreams streams, std::int64_t shift
   fill_serial(pose_.get(), pose_next_, Stream::kPose);
 }
 
+RunMerger::RunMerger(const RunFiles& files) : lidar_start_ns_(files.lidar_start_ns) {
+  if (!files.lidar.empty()) {
+    vlp16::PcapOptions options;
+    options.ports = {vlp16::kDataPort, vlp16::kPositionPort};
+    pcap_ = std::make_unique<vlp16::PcapSource>(files.lidar, options);
+  }
+  const auto open_serial = [](const fs::path& file, const serial::ReplayOptions& options) {
+    return file.empty() ? nullptr : std::make_unique<serial::ReplaySource>(file.string(), options);
+  };
+  gnss_ = open_serial(files.gnss, files.gnss_options);
+  imu_ = open_serial(files.imu, files.imu_options);
+  fill_lidar();
+  fill_serial(gnss_.get(), gnss_next_, Stream::kGnss);
+  fill_serial(imu_.get(), imu_next_, Stream::kImu);
+}
+
 RunMerger::~RunMerger() = default;
 
 void RunMerger::fill_lidar() {
@@ -51,7 +67,8 @@ void RunMerger::fill_lidar() {
       continue;
     }
     lidar_.have = true;
-    lidar_.t = d.receive_time_ns + shift_ns_;
+    if (lidar_start_ns_ && !lidar_shift_ns_) lidar_shift_ns_ = *lidar_start_ns_ - d.receive_time_ns;
+    lidar_.t = d.receive_time_ns + lidar_shift_ns_.value_or(0) + shift_ns_;
     lidar_.stream = d.destination_port == vlp16::kPositionPort ? Stream::kLidarPosition : Stream::kLidarData;
     lidar_.bytes.assign(d.payload.begin(), d.payload.end());
     return;

@@ -7,9 +7,8 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "raw_timing.hpp"
 #include "trajroi/framing/little_endian.hpp"
-#include "trajroi/ublox/framer.hpp"
-#include "trajroi/ublox/messages.hpp"
 #include "trajroi/vn100/decoder.hpp"
 #include "trajroi/vn100/framer.hpp"
 
@@ -19,7 +18,17 @@ namespace {
 
 constexpr std::size_t kHeaderBytes = 16;
 constexpr std::size_t kRecordHeaderBytes = 12;
-constexpr std::int64_t kWeek_ms = 7LL * 24 * 3600 * 1000;
+
+// Whether any CRC-valid VN-100 frame of the file carries TimeStartup.
+bool has_vn100_time_startup(std::span<const std::uint8_t> bytes) {
+  bool found = false;
+  vn100::Framer framer;
+  framer.feed(bytes, [&found](std::span<const std::uint8_t> frame) {
+    vn100::Sample s;
+    found = found || (vn100::decode(frame, s) && s.has(vn100::Field::kTimeStartup));
+  });
+  return found;
+}
 
 std::string system_error(const std::string& path, const char* what) {
   return path + ": " + what + ": " + std::strerror(errno);
@@ -131,15 +140,30 @@ void ReplaySource::index_raw() {
     return;
   }
 
+  const auto take = [this](const std::vector<raw_timing::TimedSpan>& spans) {
+    for (const raw_timing::TimedSpan& t : spans)
+      spans_.push_back({t.offset, t.length, t.time_ns});
+    return !spans.empty();
+  };
+  if (options_.raw_timing == RawTiming::kUbxTime) {
+    if (!take(raw_timing::ubx_epochs(bytes, options_.start_time_ns)) && !data_.empty()) {
+      throw std::runtime_error(path_ + ": no UBX NAV epoch to time the log by");
+    }
+    return;
+  }
+  if (take(raw_timing::logger_markers(bytes, options_.start_time_ns))) return;
+  if (options_.frames_per_second > 0.0 && !has_vn100_time_startup(bytes)) {
+    (void)take(raw_timing::at_sync_bytes(bytes, vn100::kSync, options_.frames_per_second, options_.start_time_ns));
+    return;
+  }
+
   // Frame the file; each frame closes a chunk that starts where the previous one ended.
   std::size_t chunk_start = 0;
   std::size_t consumed = 0;
   std::int64_t last_time = options_.start_time_ns;
   bool have_sensor_time = false;
-  std::int64_t sensor0 = 0;    // sensor clock (ns) of the first timed frame
-  std::int64_t host0 = 0;      // host time given to it
-  std::int64_t itow_base = 0;  // week rollovers of iTOW
-  std::int64_t last_itow = -1;
+  std::int64_t sensor0 = 0;  // sensor clock (ns) of the first timed frame
+  std::int64_t host0 = 0;    // host time given to it
   std::size_t last_timed_end = 0;
   std::int64_t last_timed_time = 0;
 
@@ -178,28 +202,12 @@ void ReplaySource::index_raw() {
     framer.finish(on_frame);
   };
 
-  if (options_.raw_timing == RawTiming::kUbxTime) {
-    ublox::Framer framer;
-    feed_and_close(framer, [&](const ublox::Message& m) {
-      bool timed = false;
-      std::int64_t sensor_ns = 0;
-      if (m.msg_class == ublox::kClassNav && m.msg_id == ublox::kIdNavPvt && m.payload.size() >= 4) {
-        const std::int64_t itow = framing::le_u32(m.payload, 0);
-        if (last_itow >= 0 && itow + kWeek_ms / 2 < last_itow) itow_base += kWeek_ms;
-        last_itow = itow;
-        sensor_ns = (itow_base + itow) * 1'000'000;
-        timed = true;
-      }
-      close_chunk(consumed, timed, sensor_ns);
-    });
-  } else {
-    vn100::Framer framer;
-    feed_and_close(framer, [&](std::span<const std::uint8_t> frame) {
-      vn100::Sample s;
-      const bool timed = vn100::decode(frame, s) && s.has(vn100::Field::kTimeStartup);
-      close_chunk(consumed, timed, timed ? static_cast<std::int64_t>(s.time_startup_ns) : 0);
-    });
-  }
+  vn100::Framer framer;
+  feed_and_close(framer, [&](std::span<const std::uint8_t> frame) {
+    vn100::Sample s;
+    const bool timed = vn100::decode(frame, s) && s.has(vn100::Field::kTimeStartup);
+    close_chunk(consumed, timed, timed ? static_cast<std::int64_t>(s.time_startup_ns) : 0);
+  });
   if (chunk_start < data_.size()) close_chunk(data_.size(), false, 0);
 }
 

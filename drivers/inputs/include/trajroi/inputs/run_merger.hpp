@@ -7,16 +7,15 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "trajroi/inputs/input_source.hpp"
+#include "trajroi/serial/byte_log.hpp"
 
 namespace trajroi::vlp16 {
 class PcapSource;
-}
-namespace trajroi::serial {
-class ReplaySource;
 }
 
 namespace trajroi::inputs {
@@ -30,12 +29,26 @@ struct RunStreams {
   bool lidar = true, gnss = true, imu = true;
 };
 
+// Captures named one by one instead of a run folder (trajroi feed): a pcap, and serial files
+// (recordings, or raw logs timed by their options: serial::RawTiming). Empty paths are silent
+// streams.
+struct RunFiles {
+  std::filesystem::path lidar, gnss, imu;
+  serial::ReplayOptions gnss_options, imu_options;
+  // The pcap's datagrams keep their recorded spacing, the first one at this time (the serial
+  // files' raw times start at their options' start_time_ns); unset: as recorded.
+  std::optional<std::int64_t> lidar_start_ns;
+};
+
 class RunMerger {
  public:
   // Opens the folder's recordings (the streams asked for). A missing gnss.trjb or imu.trjb
   // leaves that stream silent (missing() names it); a missing or unreadable lidar.pcap
   // throws std::runtime_error naming it. `shift_ns` is added to every recorded time.
   RunMerger(const std::filesystem::path& dir, RunStreams streams = {}, std::int64_t shift_ns = 0);
+  // The same merge over captures named one by one. Throws std::runtime_error naming a file that
+  // cannot be read (or, raw, timed).
+  explicit RunMerger(const RunFiles& files);
   ~RunMerger();
   RunMerger(const RunMerger&) = delete;
   RunMerger& operator=(const RunMerger&) = delete;
@@ -67,7 +80,9 @@ class RunMerger {
 
   std::unique_ptr<vlp16::PcapSource> pcap_;
   std::unique_ptr<serial::ReplaySource> gnss_, imu_, pose_;
-  std::int64_t shift_ns_;
+  std::int64_t shift_ns_ = 0;
+  std::optional<std::int64_t> lidar_start_ns_;  // RunFiles::lidar_start_ns
+  std::optional<std::int64_t> lidar_shift_ns_;  // set at the first datagram
   Pending lidar_, gnss_next_, imu_next_, pose_next_;
   std::vector<std::uint8_t> out_;  // the item handed out
   std::vector<std::string> missing_;

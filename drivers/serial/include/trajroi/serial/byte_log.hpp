@@ -10,8 +10,8 @@
 //
 // Raw byte files (a capture with no timestamps, e.g. `cat /dev/ttyACM0 > gnss.ubx`) replay
 // in chunks with times synthesised either at a nominal byte rate (a serial line at B baud
-// carries B/10 bytes/s) or from the sensor's own clock: UBX NAV iTOW or VN-100 TimeStartup,
-// one chunk per frame, the bytes before a frame riding with it.
+// carries B/10 bytes/s) or from the sensor's own clock: a u-blox receiver's epochs (NAV iTOW),
+// a VN-100 logger's markers or its frames' TimeStartup.
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -45,8 +45,13 @@ class RecordingWriter {
 
 enum class RawTiming : std::uint8_t {
   kNominalRate,  // chunk_bytes per chunk at bytes_per_second
-  kUbxTime,      // one chunk per UBX frame, spaced by NAV iTOW (nominal rate before the first)
-  kVn100Time,    // one chunk per VN-100 frame, spaced by TimeStartup (nominal rate without)
+  // One chunk per epoch, cut after its last NAV message (NAV-EOE, else NAV-PVT), at its iTOW:
+  // the receiver's own bursts at its own pace. A log without a NAV epoch is an error.
+  kUbxTime,
+  // The LoggerWavesInIce logger's `M,<millis>` markers when the log has them; else one chunk
+  // per VN-100 frame by its TimeStartup when frames carry it; else one chunk per 0xFA sync byte
+  // at frames_per_second (nominal byte rate when 0).
+  kVn100Time,
 };
 
 struct ReplayOptions {
@@ -54,6 +59,7 @@ struct ReplayOptions {
   double bytes_per_second = 11'520.0;  // 115200 baud, 8N1
   std::size_t chunk_bytes = 64;
   std::int64_t start_time_ns = 0;  // host time given to the first byte of a raw file
+  double frames_per_second = 0.0;  // kVn100Time's last resort
 };
 
 // Replays a recording (detected by its magic) or a raw byte file. Throws std::runtime_error
