@@ -42,7 +42,8 @@ std::vector<TimedSpan> ubx_epochs(std::span<const std::uint8_t> data, std::int64
     out.push_back({chunk_start, end - chunk_start, t});
     chunk_start = end;
   });
-  if (!out.empty() && chunk_start < data.size()) out.push_back({chunk_start, data.size() - chunk_start, out.back().time_ns});
+  if (!out.empty() && chunk_start < data.size())
+    out.push_back({chunk_start, data.size() - chunk_start, out.back().time_ns});
   return out;
 }
 
