@@ -2,7 +2,7 @@
 
 // The paper's evaluations on a simulated run (Tables 9, 11, 18, 19 and 20), through the
 // daemon's own per-sweep pipeline: the run's recordings merged as trajroid merges them and fed
-// to daemon::SweepProcessor (decode, pose per firing or per sweep, transform, ROI chain placed
+// to pipeline::SweepProcessor (decode, pose per firing or per sweep, transform, ROI chain placed
 // at the sweep's start from the robot's projection, exact filter), configured from the run's
 // trajroid.yaml with the scenario's evaluation sizes. The simulator's truth (the true pose at
 // every firing) says where each measured point really is, so pose errors show in the figures.
@@ -96,7 +96,7 @@ class PipelineObserver {
 };
 
 // One pass over the run's recordings (merged by receive time, as trajroid's replay) through one
-// daemon::SweepProcessor per configuration, sweeps carrying their point indices. Stops after
+// pipeline::SweepProcessor per configuration, sweeps carrying their point indices. Stops after
 // the sweep that ends at or after `until_ns`.
 void run_pipelines(const ScenarioRun& run, std::span<const daemon::DaemonConfig> configs, PipelineObserver& observer,
                    std::int64_t until_ns = std::numeric_limits<std::int64_t>::max());
