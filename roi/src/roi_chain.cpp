@@ -34,6 +34,10 @@ FilterStats RoiChain::filter(std::span<const PointXYZI> points, IndexVector& kep
   return shape_ == RoiShape::kCircular ? circle_grid_.filter(points, kept) : rect_grid_.filter(points, kept);
 }
 
+FilterStats RoiChain::filter(std::span<const PointXYZd> points, IndexVector& kept) const {
+  return shape_ == RoiShape::kCircular ? circle_grid_.filter(points, kept) : rect_grid_.filter(points, kept);
+}
+
 ScanCalibration RoiChain::calibrate() const {
   return shape_ == RoiShape::kCircular ? circle_grid_.calibrate() : rect_grid_.calibrate();
 }

@@ -15,6 +15,7 @@
 #include "trajroi/roi/cuboid.hpp"
 #include "trajroi/roi/grid_filter.hpp"
 #include "trajroi/roi/reference_filter.hpp"
+#include "trajroi/roi/roi_chain.hpp"
 #include "trajroi/roi/shapes.hpp"
 #include "trajroi/roi/text.hpp"
 #include "trajroi/roi/transform.hpp"
@@ -104,15 +105,29 @@ void run_filter(const FilterOptions& o) {
   roi::IndexVector kept;
   roi::FilterStats stats;
   std::vector<roi::Centre> centres;
-  if (o.shape == "circular") {
-    const double diameter = require(o.diameter_m, "--diameter", o.shape);
-    roi::place_centres(trajectory, o.start_s_m, o.look_ahead_m, spacing(o, diameter), centres);
-    stats = run_chain(roi::CircularRoiSet(diameter / 2.0, centres, z), o.algorithm, points, kept);
-  } else if (o.shape == "rectangular") {
-    const double height = require(o.height_m, "--height", o.shape);
-    const double width = require(o.width_m, "--width", o.shape);
-    roi::place_centres(trajectory, o.start_s_m, o.look_ahead_m, spacing(o, height), centres);
-    stats = run_chain(roi::RectangularRoiSet(height, width, centres, z), o.algorithm, points, kept);
+  if (o.shape == "circular" || o.shape == "rectangular") {
+    // The chain the daemon places each sweep (roi::RoiChain), or the paper's double loop over
+    // the same shapes.
+    const bool circular = o.shape == "circular";
+    roi::ChainSize size;
+    if (circular) {
+      size.radius_m = require(o.diameter_m, "--diameter", o.shape) / 2.0;
+    } else {
+      size.height_m = require(o.height_m, "--height", o.shape);
+      size.width_m = require(o.width_m, "--width", o.shape);
+    }
+    const double spacing_m = spacing(o, circular ? 2.0 * size.radius_m : size.height_m);
+    roi::place_centres(trajectory, o.start_s_m, o.look_ahead_m, spacing_m, centres);  // checks the spacing first
+    const std::span<const roi::PointXYZd> cloud(points);
+    if (o.algorithm == "reference") {
+      stats = circular
+                  ? roi::reference_filter(roi::CircularRoiSet(size.radius_m, centres, z), cloud, kept)
+                  : roi::reference_filter(roi::RectangularRoiSet(size.height_m, size.width_m, centres, z), cloud, kept);
+    } else {
+      roi::RoiChain chain(circular ? roi::RoiShape::kCircular : roi::RoiShape::kRectangular, size, z);
+      chain.place(trajectory, o.start_s_m, o.look_ahead_m, spacing_m, size);
+      stats = chain.filter(cloud, kept);
+    }
   } else if (o.shape == "corridor") {
     const double width = require(o.width_m, "--width", o.shape);
     stats = run_chain(roi::CorridorRoiSet(trajectory, 0.0, inf, width, z), o.algorithm, points, kept);

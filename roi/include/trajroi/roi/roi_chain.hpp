@@ -39,8 +39,10 @@ class RoiChain {
   // and errors), the shapes of `size` on them, and the grid over them.
   void place(const Trajectory& trajectory, double s0_m, double look_ahead_m, double spacing_m, const ChainSize& size);
 
-  // The indices of the points inside the chain, into `kept` (cleared first).
+  // The indices of the points inside the chain, into `kept` (cleared first). Double-precision
+  // clouds (points read from text) are decided without rounding to float.
   FilterStats filter(std::span<const PointXYZI> points, IndexVector& kept) const;
+  FilterStats filter(std::span<const PointXYZd> points, IndexVector& kept) const;
 
   // Times the scans on the placed chain and makes the fastest the one filter() runs
   // (GridFilter::calibrate).
