@@ -1,8 +1,12 @@
 #include "health.hpp"
 
+#include <arpa/inet.h>
+
 #include <cmath>
 #include <cstdio>
 
+#include "health_format.hpp"
+#include "trajroi/pipeline/pose_words.hpp"
 #include "trajroi/vlp16/packet.hpp"
 
 namespace trajroi::daemon {
@@ -11,19 +15,39 @@ namespace {
 
 using C = Counter;
 
-std::string format(const char* pattern, auto... args) {
-  char text[512];
-  std::snprintf(text, sizeof text, pattern, args...);
-  return text;
+std::uint64_t rejected(const StatusSnapshot& s, vlp16::PacketError e) {
+  return s.counters[static_cast<std::size_t>(C::kLidarRejected) + static_cast<std::size_t>(e) - 1];
+}
+
+std::uint64_t rejected_total(const StatusSnapshot& s) {
+  std::uint64_t n = 0;
+  for (std::size_t e = 1; e < vlp16::kPacketErrorCount; ++e)
+    n += s.counters[static_cast<std::size_t>(C::kLidarRejected) + e - 1];
+  return n;
 }
 
 }  // namespace
+
+std::string sender_list(const StatusSnapshot& s) {
+  std::string text;
+  for (const std::uint64_t sender : s.foreign_senders) {
+    if (sender == 0) continue;
+    in_addr address{};
+    address.s_addr = htonl(static_cast<std::uint32_t>(sender >> 16));
+    char name[INET_ADDRSTRLEN] = "?";
+    inet_ntop(AF_INET, &address, name, sizeof name);
+    text += (text.empty() ? "" : ", ") + std::string(name) + ":" + std::to_string(sender & 0xFFFF);
+  }
+  if (s.foreign_from_others > 0) text += " and others";
+  return text.empty() ? "senders unknown" : "from " + text;
+}
 
 HealthMonitor::HealthMonitor(const DaemonConfig& config, bool live, std::int64_t start_steady_ns)
     : config_(config), live_(live) {
   StatusSnapshot start;  // every counter starts at zero
   start.steady_ns = start_steady_ns;
   history_.push_back(start);
+  minute_start_ = start;
 }
 
 void HealthMonitor::set(Fault fault, bool active, std::string warning, std::string ended,
@@ -39,119 +63,138 @@ std::vector<HealthLine> HealthMonitor::update(const StatusSnapshot& s) {
   history_.push_back(s);
   while (history_.size() > 2 && s.steady_ns - history_[1].steady_ns >= kWindow_ns)
     history_.pop_front();
-  const StatusSnapshot& base = history_.front();
-  const double window_s = static_cast<double>(s.steady_ns - base.steady_ns) * 1e-9;
-  const bool judged = s.steady_ns - base.steady_ns >= kWindow_ns;  // enough history for "nothing came"
-  const auto delta = [&](C c) { return s[c] - base[c]; };
-  const auto step = [&](C c) { return s[c] - previous[c]; };
-  const auto rejected = [&](vlp16::PacketError e) {
-    return s.counters[static_cast<std::size_t>(C::kLidarRejected) + static_cast<std::size_t>(e) - 1];
-  };
-  const auto rejected_before = [&](vlp16::PacketError e) {
-    return previous.counters[static_cast<std::size_t>(C::kLidarRejected) + static_cast<std::size_t>(e) - 1];
-  };
-  const DaemonConfig::Lidar& l = config_.lidar;
 
-  // LiDAR: nothing at all, or only from other senders.
-  const std::uint64_t accepted = (s.lidar_packets + s.position_packets) - (base.lidar_packets + base.position_packets);
-  const std::uint64_t foreign = delta(C::kLidarRejectedSource);
-  const bool silent = live_ && judged && accepted == 0 && foreign == 0 && delta(C::kLidarOversize) == 0;
-  set(kLidarSilent, silent,
-      format("lidar: no datagrams for %.0f s on UDP %s:%u (data) / %u (position): sensor off or unplugged, or "
-             "sending to another port or address?",
-             window_s, l.bind_address.c_str(), l.data_port, l.position_port),
-      format("lidar: datagrams arriving on UDP port %u", l.data_port), out);
-  set(kLidarForeignOnly, live_ && accepted == 0 && foreign > 0,
-      format("lidar: %llu datagrams in %.0f s on UDP port %u, none from sensor_address %s: is lidar.sensor_address "
-             "the sensor's?",
-             static_cast<unsigned long long>(foreign), window_s, l.data_port, l.sensor_address.c_str()),
-      "lidar: datagrams from the sensor_address arriving", out);
-  if (const std::uint64_t n =
-          rejected(vlp16::PacketError::kUnsupportedProduct) - rejected_before(vlp16::PacketError::kUnsupportedProduct);
-      n > 0) {
-    const std::string reason = s.model_reason.data();
-    out.push_back({HealthLine::Level::kWarning,
-                   format("lidar: %llu packets rejected in the last second: %s (trajroid decodes the VLP-16 only; "
-                          "lidar.rejected.unsupported_product %llu)",
-                          static_cast<unsigned long long>(n), reason.empty() ? "not a VLP-16" : reason.c_str(),
-                          static_cast<unsigned long long>(rejected(vlp16::PacketError::kUnsupportedProduct)))});
-  }
-  if (const std::uint64_t n = step(C::kLidarClockJumps); n > 0) {
-    out.push_back(
-        {HealthLine::Level::kWarning,
-         format("lidar: the sensor's clock jumped forward %llu time(s) in the last second (a time "
-                "re-sync?): not counted as lost packets (lidar.clock_jumps %llu)",
-                static_cast<unsigned long long>(n), static_cast<unsigned long long>(s[C::kLidarClockJumps]))});
-  }
-
-  // The serial streams the pose source reads.
-  const bool gnss_used = (config_.pose_source == PoseSource::kGnssImu || config_.pose_source == PoseSource::kGnss) &&
-                         !config_.gnss.device.empty();
-  const bool imu_used = config_.pose_source == PoseSource::kGnssImu && !config_.imu.device.empty();
-  const auto serial = [&](bool used, const char* name, const DaemonConfig::Serial& dev, C bytes, C frames,
-                          C foreign_frames, const char* protocol, const char* other, Fault silent_fault,
-                          Fault no_frames_fault) {
-    const bool no_bytes = live_ && used && judged && delta(bytes) == 0;
-    set(silent_fault, no_bytes,
-        format("%s: no bytes for %.0f s from %s: receiver off, or its output on another port?", name, window_s,
-               dev.device.c_str()),
-        format("%s: bytes arriving from %s", name, dev.device.c_str()), out);
-    const bool garbage = used && judged && delta(bytes) > 0 && delta(frames) == 0;
-    std::string why;
-    if (delta(foreign_frames) > 0) {
-      why =
-          format("%s: %llu %s frames (and no %s frame) in %.0f s from %s: gnss.device and imu.device swapped?", name,
-                 static_cast<unsigned long long>(delta(foreign_frames)), other, protocol, window_s, dev.device.c_str());
-    } else {
-      why = format("%s: %llu bytes in %.0f s from %s at %d baud but no %s frame: wrong baud rate?", name,
-                   static_cast<unsigned long long>(delta(bytes)), window_s, dev.device.c_str(), dev.baud, protocol);
-    }
-    set(no_frames_fault, garbage, why, format("%s: %s frames arriving", name, protocol), out);
-  };
-  serial(gnss_used, "gnss", config_.gnss, C::kGnssBytes, C::kGnssFrames, C::kGnssForeignFrames, "UBX", "VN-100",
-         kGnssSilent, kGnssNoFrames);
-  serial(imu_used, "imu", config_.imu, C::kImuBytes, C::kImuFrames, C::kImuForeignFrames, "VN-100", "UBX", kImuSilent,
-         kImuNoFrames);
-  set(kGnssNoPvt, gnss_used && judged && delta(C::kGnssFrames) > 0 && delta(C::kPoseFixes) == 0,
-      format("gnss: %llu UBX frames in %.0f s but no NAV-PVT: enable UBX-NAV-PVT output on this port (%s)",
-             static_cast<unsigned long long>(delta(C::kGnssFrames)), window_s, config_.gnss.device.c_str()),
-      "gnss: NAV-PVT arriving", out);
-  set(kImuNoAttitude, imu_used && judged && delta(C::kPoseImuWithoutAttitude) > 0 && delta(C::kPoseAttitudes) == 0,
-      format("imu: %llu VN-100 frames in %.0f s carry no YawPitchRoll, Quaternion or DCM: add one to the binary "
-             "output (register 75)",
-             static_cast<unsigned long long>(delta(C::kPoseImuWithoutAttitude)), window_s),
-      "imu: attitudes arriving", out);
+  lidar(s, out);
+  serial_ports(s, out);
+  localization(s, out);
+  minute_summary(s, out);
 
   // The trajectory: nothing near the robot to keep.
   const double far_m = std::max(50.0, config_.roi.look_ahead_m);
   const bool far = std::isfinite(s.trajectory_distance_m) && s.trajectory_distance_m > far_m;
   set(kTrajectoryFar, far,
-      format("trajectory %d: the robot is %.0f m from it (more than %.0f m): nothing near the robot is kept; is it "
-             "this site's trajectory, and global_frame.origin right?",
-             s.trajectory_id, s.trajectory_distance_m, far_m),
-      format("trajectory %d: the robot is back within %.0f m of it", s.trajectory_id, far_m), out);
+      sprintf_text(
+          "trajectory %d: the robot is %.0f m from it (more than %.0f m): nothing near the robot is kept; is it "
+          "this site's trajectory, and global_frame.origin right?",
+          s.trajectory_id, s.trajectory_distance_m, far_m),
+      sprintf_text("trajectory %d: the robot is back within %.0f m of it", s.trajectory_id, far_m), out);
 
   // The host clock against GNSS time (live: in a replay the recording's receiver is not now).
   const double offset = s.host_minus_gnss_utc_s;
   set(kClockOffset, live_ && std::isfinite(offset) && std::abs(offset) > config_.time.max_gnss_offset_s,
-      format("time: the host clock is %.3f s %s GNSS UTC (more than time.max_gnss_offset_s %.3f s): is NTP/chrony "
-             "running and synchronised?",
-             std::abs(offset), offset > 0 ? "ahead of" : "behind", config_.time.max_gnss_offset_s),
-      format("time: the host clock is within %.3f s of GNSS UTC", config_.time.max_gnss_offset_s), out);
+      sprintf_text(
+          "time: the host clock is %.3f s %s GNSS UTC (more than time.max_gnss_offset_s %.3f s): is NTP/chrony "
+          "running and synchronised?",
+          std::abs(offset), offset > 0 ? "ahead of" : "behind", config_.time.max_gnss_offset_s),
+      sprintf_text("time: the host clock is within %.3f s of GNSS UTC", config_.time.max_gnss_offset_s), out);
 
-  // The state in words.
+  update_state(s, previous);
+  return out;
+}
+
+void HealthMonitor::lidar(const StatusSnapshot& s, std::vector<HealthLine>& out) {
+  const StatusSnapshot& previous = history_[history_.size() - 2];
+  const StatusSnapshot& base = history_.front();
+  const DaemonConfig::Lidar& l = config_.lidar;
+  const double window = window_s(s);
+  // Nothing at all, only from other senders, or only datagrams that are not VLP-16 packets.
+  const std::uint64_t accepted = (s.lidar_packets + s.position_packets) - (base.lidar_packets + base.position_packets);
+  const std::uint64_t foreign = delta(s, C::kLidarRejectedSource);
+  const std::uint64_t not_vlp16 = delta(s, C::kLidarNotVlp16);
+  const bool silent = live_ && judged(s) && accepted == 0 && foreign == 0 && not_vlp16 == 0 &&
+                      delta(s, C::kLidarOversize) == 0 && rejected_total(s) == rejected_total(base);
+  set(kLidarSilent, silent,
+      sprintf_text("lidar: no datagrams for %.0f s on UDP %s:%u (data) / %u (position): sensor off or unplugged, or "
+                   "sending to another port or address?",
+                   window, l.bind_address.c_str(), l.data_port, l.position_port),
+      sprintf_text("lidar: datagrams arriving on UDP port %u", l.data_port), out);
+  set(kLidarForeignOnly, live_ && accepted == 0 && foreign > 0,
+      sprintf_text(
+          "lidar: %llu datagrams in %.0f s on UDP port %u, none from sensor_address %s: is lidar.sensor_address "
+          "the sensor's?",
+          static_cast<unsigned long long>(foreign), window, l.data_port, l.sensor_address.c_str()),
+      "lidar: datagrams from the sensor_address arriving", out);
+  set(kLidarNotVlp16Only, live_ && accepted == 0 && not_vlp16 > 0,
+      sprintf_text(
+          "lidar: %llu datagrams in %.0f s on UDP port %u and none a VLP-16 data packet (%u–%u bytes; a VLP-16 "
+          "sends 1206; %s): another device sends to this port (lidar.data_port), or the sensor's output is not "
+          "its factory packet format",
+          static_cast<unsigned long long>(not_vlp16), window, l.data_port, s.foreign_min_size, s.foreign_max_size,
+          sender_list(s).c_str()),
+      sprintf_text("lidar: VLP-16 packets arriving on UDP port %u", l.data_port), out);
+  const auto unsupported = [](const StatusSnapshot& x) { return rejected(x, vlp16::PacketError::kUnsupportedProduct); };
+  if (const std::uint64_t n = unsupported(s) - unsupported(previous); n > 0) {
+    const std::string reason = s.model_reason.data();
+    out.push_back(
+        {HealthLine::Level::kWarning,
+         sprintf_text("lidar: %llu packets rejected in the last second: %s (trajroid decodes the VLP-16 only; "
+                      "lidar.rejected.unsupported_product %llu)",
+                      static_cast<unsigned long long>(n), reason.empty() ? "not a VLP-16" : reason.c_str(),
+                      static_cast<unsigned long long>(unsupported(s)))});
+  }
+  if (const std::uint64_t n = s[C::kLidarClockJumps] - previous[C::kLidarClockJumps]; n > 0) {
+    out.push_back(
+        {HealthLine::Level::kWarning,
+         sprintf_text("lidar: the sensor's clock jumped forward %llu time(s) in the last second (a time "
+                      "re-sync?): not counted as lost packets (lidar.clock_jumps %llu)",
+                      static_cast<unsigned long long>(n), static_cast<unsigned long long>(s[C::kLidarClockJumps]))});
+  }
+}
+
+void HealthMonitor::minute_summary(const StatusSnapshot& s, std::vector<HealthLine>& out) {
+  constexpr std::int64_t kMinute_ns = 60'000'000'000;
+  if (s.steady_ns - minute_start_.steady_ns < kMinute_ns && !s.final) return;
+  const std::uint64_t other = s[C::kLidarNotVlp16] - minute_start_[C::kLidarNotVlp16];
+  const std::uint64_t packets = s.lidar_packets - minute_start_.lidar_packets;
+  if (live_ && other > 0 && packets > 0) {
+    out.push_back(
+        {HealthLine::Level::kWarning,
+         sprintf_text("lidar: %llu datagrams in the last %.0f s on UDP port %u were not VLP-16 data packets, "
+                      "beside %llu packets (%u–%u bytes; %s): another device sends to the sensor's port "
+                      "(lidar.not_vlp16_datagrams %llu)",
+                      static_cast<unsigned long long>(other),
+                      static_cast<double>(s.steady_ns - minute_start_.steady_ns) * 1e-9, config_.lidar.data_port,
+                      static_cast<unsigned long long>(packets), s.foreign_min_size, s.foreign_max_size,
+                      sender_list(s).c_str(), static_cast<unsigned long long>(s[C::kLidarNotVlp16]))});
+  }
+  minute_start_ = s;
+}
+
+void HealthMonitor::update_state(const StatusSnapshot& s, const StatusSnapshot& previous) {
+  const DaemonConfig::Lidar& l = config_.lidar;
+  std::string problems;
+  const auto add = [&problems](const std::string& p) { problems += (problems.empty() ? "" : "; ") + p; };
+  if (active_[kLidarNotVlp16Only]) {
+    add(sprintf_text("LiDAR: no VLP-16 packets on UDP port %u, only other datagrams", l.data_port));
+  } else if (active_[kLidarForeignOnly]) {
+    add(sprintf_text("LiDAR: datagrams on UDP port %u only from addresses other than sensor_address %s", l.data_port,
+                     l.sensor_address.c_str()));
+  } else if (active_[kLidarSilent] || (live_ && s.lidar_packets == 0)) {
+    add(sprintf_text("waiting for LiDAR data on UDP port %u", l.data_port));
+  }
+  bool pose_input_fault = false;
+  for (const std::string& serial : serial_state_) {
+    if (!serial.empty()) add(serial), pose_input_fault = true;
+  }
+  if (active_[kLocalizationSilent] || active_[kLocalizationInvalid] || active_[kLocalizationMalformed]) {
+    pose_input_fault = true;
+    add(active_[kLocalizationSilent] ? "localization: no pose_input_t on " + config_.lcm.pose_input
+        : active_[kLocalizationInvalid]
+            ? std::string("localization: its poses are marked invalid")
+            : "localization: messages on " + config_.lcm.pose_input + " are not pose_input_t");
+  }
+  // The pose's own reason when no input explains it.
+  if (!s.pose_valid && !pose_input_fault)
+    add("no valid pose: " + pipeline::pose_reason(s.pose_status, s.pose_measured, s.pose_limit, config_));
   const double since_s = static_cast<double>(s.steady_ns - previous.steady_ns) * 1e-9;
   const auto published = s.processor.sweeps_filtered - previous.processor.sweeps_filtered;
-  if (active_[kLidarSilent] || (live_ && s.lidar_packets == 0)) {
-    state_ = format("waiting for LiDAR data on UDP port %u", l.data_port);
-  } else if (!s.pose_valid && s.processor.sweeps > 0) {
-    state_ = "no valid pose: " + std::string(pose::to_string(s.pose_status));
+  if (!problems.empty()) {
+    state_ = problems;
   } else if (published > 0 && since_s > 0.0) {
-    state_ = format("publishing %.1f sweeps/s", static_cast<double>(published) / since_s);
+    state_ = sprintf_text("publishing %.1f sweeps/s", static_cast<double>(published) / since_s);
   } else {
     state_ = "receiving LiDAR data, no sweep published in the last second";
   }
-  return out;
 }
 
 }  // namespace trajroi::daemon

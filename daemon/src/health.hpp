@@ -2,9 +2,12 @@
 
 // Every fault named: once a second the publisher hands each status snapshot here; a fault
 // seen over the last few seconds (the counters' change since then) is said in one log line
-// with its figures when it starts — within 5 s of the start or of the fault — and once more
-// when it ends. The same look gives systemd's STATUS= its words ("waiting for LiDAR data on
-// UDP port 2368", "no valid pose: no GNSS fix yet", "publishing 10.0 sweeps/s").
+// with its figures and its remedy when it starts — within 5 s of the start or of the fault —
+// and once more when it ends. The same look gives systemd's STATUS= its words: each input that
+// is missing or wrong, by name, and only the inputs the pose source uses ("waiting for LiDAR
+// data on UDP port 2368; GNSS: NMEA text, no UBX, from /dev/ttyACM0", "no valid pose: newest
+// localization pose too old: …", "publishing 10.0 sweeps/s"). A mix of VLP-16 packets and
+// other datagrams on the LiDAR port is summarised once a minute.
 #include <cstdint>
 #include <deque>
 #include <string>
@@ -37,12 +40,16 @@ class HealthMonitor {
   enum Fault : std::uint8_t {
     kLidarSilent,
     kLidarForeignOnly,
+    kLidarNotVlp16Only,
     kGnssSilent,
     kGnssNoFrames,
     kGnssNoPvt,
     kImuSilent,
     kImuNoFrames,
     kImuNoAttitude,
+    kLocalizationSilent,
+    kLocalizationInvalid,
+    kLocalizationMalformed,
     kTrajectoryFar,
     kClockOffset,
     kFaultCount
@@ -50,12 +57,36 @@ class HealthMonitor {
   // Raises or clears `fault`: true → the warning (once, as it starts); false → the info line
   // (once, as it ends) when `ended` is given.
   void set(Fault fault, bool active, std::string warning, std::string ended, std::vector<HealthLine>& out);
+  // The faults of each kind of input (health.cpp, health_pose_inputs.cpp).
+  void lidar(const StatusSnapshot& s, std::vector<HealthLine>& out);
+  void serial_ports(const StatusSnapshot& s, std::vector<HealthLine>& out);
+  void localization(const StatusSnapshot& s, std::vector<HealthLine>& out);
+  void minute_summary(const StatusSnapshot& s, std::vector<HealthLine>& out);
+  // The state in words, from the faults now active.
+  void update_state(const StatusSnapshot& s, const StatusSnapshot& previous);
+  // The counters' change over the window (the oldest snapshot kept to `s`).
+  [[nodiscard]] std::uint64_t delta(const StatusSnapshot& s, Counter c) const noexcept {
+    return s[c] - history_.front()[c];
+  }
+  [[nodiscard]] double window_s(const StatusSnapshot& s) const noexcept {
+    return static_cast<double>(s.steady_ns - history_.front().steady_ns) * 1e-9;
+  }
+  [[nodiscard]] bool judged(const StatusSnapshot& s) const noexcept {
+    return s.steady_ns - history_.front().steady_ns >= kWindow_ns;  // enough history for "nothing came"
+  }
 
   const DaemonConfig& config_;
   bool live_;
   std::deque<StatusSnapshot> history_;  // oldest first; the first is the all-zero start
   bool active_[kFaultCount] = {};
+  // Each serial port's fault in a few words for the state ("NMEA text, no UBX"): GNSS, IMU.
+  std::string serial_state_[2];
+  StatusSnapshot minute_start_;  // the mixed LiDAR port's summary
   std::string state_ = "starting";
 };
+
+// The pose source's inputs in figures, for the status line: "gnss fix 3, h_acc 0.52 m, age
+// 0.10 s; imu attitude age 0.01 s", "localization pose age 0.05 s", "pose fixed (pose.fixed)".
+[[nodiscard]] std::string pose_inputs_text(const StatusSnapshot& s, const DaemonConfig& config);
 
 }  // namespace trajroi::daemon

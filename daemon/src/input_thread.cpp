@@ -21,6 +21,7 @@ void copy_counters(const inputs::InputSource& source, InputLane& lane) {
   lane.disconnects.store(c.disconnects, std::memory_order_relaxed);
   lane.rejected_sources.store(c.rejected_sources, std::memory_order_relaxed);
   lane.kernel_drops.store(c.kernel_drops, std::memory_order_relaxed);
+  lane.closed_streams.store(c.closed_streams, std::memory_order_relaxed);
 }
 
 // The processing thread is also woken this far ahead of the cut, so the items held then are
@@ -113,6 +114,11 @@ void input_loop(Pipeline& pipeline, InputLane& lane) {
                   suppressed > 0 ? " (" + std::to_string(suppressed) + " similar suppressed)" : std::string());
       }
       continue;
+    }
+    if (item.stream == inputs::Stream::kLidarData) {
+      const vlp16::PacketError e = vlp16::validate_data_packet(item.bytes);
+      if (e != vlp16::PacketError::kNone && e != vlp16::PacketError::kUnsupportedProduct)
+        lane.foreign.add(item.bytes.size(), item.sender);
     }
     // One slot per datagram; serial bytes in slot-sized pieces with the same receive time.
     std::span<const std::uint8_t> rest = item.bytes;

@@ -8,6 +8,7 @@
 #include <cinttypes>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 
 #include "trajroi/host/clock.hpp"
 
@@ -83,6 +84,45 @@ void warn_limited(RateLimited& limit, const std::string& message) {
   } else {
     warn("{}", message);
   }
+}
+
+void ReasonLimiter::warn(std::uint32_t reason, const std::string& message, std::int64_t now_ns) {
+  Reason& r = reasons_[reason];
+  const std::int64_t wall = host::realtime_ns();
+  if (now_ns < r.next_ns) {
+    if (r.held++ == 0) r.first_held_wall_ns = wall;
+    r.last_held_wall_ns = wall;
+    r.last_message = message;
+    return;
+  }
+  if (r.held > 0) {
+    log::warn("{} (and {} like it from {} to {})", message, r.held, time_of_day(r.first_held_wall_ns),
+              time_of_day(r.last_held_wall_ns));
+  } else {
+    log::warn("{}", message);
+  }
+  r.held = 0;
+  r.next_ns = now_ns + interval_ns_;
+}
+
+void ReasonLimiter::flush(std::int64_t now_ns) {
+  for (auto& [reason, r] : reasons_) {
+    if (r.held == 0 || now_ns < r.next_ns) continue;
+    log::warn("{} ({} time{} from {} to {})", r.last_message, r.held, r.held == 1 ? "" : "s",
+              time_of_day(r.first_held_wall_ns), time_of_day(r.last_held_wall_ns));
+    r.held = 0;
+    r.next_ns = now_ns + interval_ns_;
+  }
+}
+
+std::string time_of_day(std::int64_t realtime_ns) {
+  const std::time_t seconds = static_cast<std::time_t>(realtime_ns / 1'000'000'000);
+  std::tm t{};
+  localtime_r(&seconds, &t);
+  char text[32];
+  std::snprintf(text, sizeof text, "%02d:%02d:%02d.%03d", t.tm_hour, t.tm_min, t.tm_sec,
+                static_cast<int>(realtime_ns % 1'000'000'000 / 1'000'000));
+  return text;
 }
 
 }  // namespace trajroi::daemon::log

@@ -6,13 +6,13 @@ MessageSender::MessageSender(Outlet& outlet, const DaemonConfig& config) : outle
 
 void MessageSender::make_resident() {
   // A page over for the head, whose size is that of an empty sweep's.
-  daemon::encode_points(pipeline::Sweep{}, config_.pose_mode, points_, points_encoded_);
+  daemon::encode_points(pipeline::Sweep{}, config_, points_, points_encoded_);
   points_encoded_.resize(points_encoded_.size() + 4096 + config_.buffers.max_points_per_sweep * kEncodedBytesPerPoint);
   points_encoded_.clear();
 }
 
 void MessageSender::send_pose(const pipeline::Sweep& s) {
-  fill_pose(s, pose_);
+  fill_pose(s, config_, pose_);
   send(config_.lcm.pose, pose_);
 }
 
@@ -22,7 +22,7 @@ void MessageSender::send_roi(const pipeline::Sweep& s) {
 }
 
 void MessageSender::encode_points(const pipeline::Sweep& s) {
-  daemon::encode_points(s, config_.pose_mode, points_, points_encoded_);
+  daemon::encode_points(s, config_, points_, points_encoded_);
 }
 
 void MessageSender::send_points() {

@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
 
+#include "trajroi/pipeline/pose_words.hpp"
 #include "trajroi/pose/attitude.hpp"
 
 namespace trajroi::daemon {
@@ -60,43 +62,47 @@ std::uint8_t* store_be32_array(std::uint8_t* out, const std::vector<T, Allocator
 }
 
 // Every field of points_t but the points.
-void fill_points_head(const pipeline::Sweep& sweep, PoseMode mode, trajroi::points_t& out) {
+void fill_points_head(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::points_t& out) {
   out.sweep_index = static_cast<std::int64_t>(sweep.index);
   out.sweep_start_ns = sweep.start_ns;
   out.sweep_end_ns = sweep.end_ns;
   out.sweep_start_utc_ns = sweep.start_utc_ns;
   out.time_source = std::string(sweep.time_source);
   out.trajectory_id = sweep.trajectory_id;
-  out.pose_mode = mode == PoseMode::kPerSweep ? trajroi::points_t::POSE_PER_SWEEP : trajroi::points_t::POSE_PER_FIRING;
+  out.pose_mode =
+      config.pose_mode == PoseMode::kPerSweep ? trajroi::points_t::POSE_PER_SWEEP : trajroi::points_t::POSE_PER_FIRING;
   out.return_mode = static_cast<std::int8_t>(sweep.return_mode);
   out.partial = sweep.partial;
   out.points_in = static_cast<std::int32_t>(sweep.points_in);
   out.lost_packets = static_cast<std::int32_t>(sweep.lost_packets);
-  fill_pose(sweep, out.pose);
+  fill_pose(sweep, config, out.pose);
   set_pose(sweep.sensor, out.sensor_position_m, out.sensor_orientation);
 }
 
 }  // namespace
 
-void fill_pose(const pipeline::Sweep& sweep, trajroi::pose_t& out) {
+void fill_pose(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::pose_t& out) {
   out.t_ns = sweep.pose_t_ns;
   out.sweep_index = static_cast<std::int64_t>(sweep.index);
   out.valid = sweep.pose_status == pose::PoseStatus::kValid;
   out.status = static_cast<std::int8_t>(sweep.pose_status);
-  out.status_text = pose::describe(sweep.pose_status, sweep.pose_measured, sweep.pose_limit);
+  out.status_text = pipeline::pose_reason(sweep.pose_status, sweep.pose_measured, sweep.pose_limit, config);
+  out.pose_source = std::string(pipeline::pose_source_name(config.pose_source));
   out.heading_source = std::string(sweep.heading_source);
   out.utc_ns = sweep.start_utc_ns;
   out.time_source = std::string(sweep.time_source);
   set_pose(sweep.robot, out.position_m, out.orientation);
   out.yaw_rad = out.valid ? pose::roll_pitch_yaw(sweep.robot.orientation).yaw_rad : 0.0;
   out.speed_mps = sweep.speed_mps;
-  out.fix_type = static_cast<std::int8_t>(sweep.fix.fix_type);
-  out.rtk_fixed = sweep.fix.rtk_fixed;
-  out.h_acc_m = sweep.fix.h_acc_m;
+  // A localization's or a fixed pose has no GNSS fix: those fields say "not applicable".
+  const bool gnss = pipeline::uses_gnss(config.pose_source);
+  out.fix_type = gnss ? static_cast<std::int8_t>(sweep.fix.fix_type) : trajroi::pose_t::NOT_APPLICABLE;
+  out.rtk_fixed = gnss && sweep.fix.rtk_fixed;
+  out.h_acc_m = gnss ? sweep.fix.h_acc_m : std::numeric_limits<double>::quiet_NaN();
 }
 
-void fill_points(const pipeline::Sweep& sweep, PoseMode mode, trajroi::points_t& out) {
-  fill_points_head(sweep, mode, out);
+void fill_points(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::points_t& out) {
+  fill_points_head(sweep, config, out);
   out.num_points = static_cast<std::int32_t>(sweep.size());
   copy_into(out.x, sweep.x);
   copy_into(out.y, sweep.y);
@@ -107,9 +113,9 @@ void fill_points(const pipeline::Sweep& sweep, PoseMode mode, trajroi::points_t&
   copy_into(out.time_offset_ns, sweep.time_offset_ns);
 }
 
-void encode_points(const pipeline::Sweep& sweep, PoseMode mode, trajroi::points_t& head,
+void encode_points(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::points_t& head,
                    std::vector<std::uint8_t>& out) {
-  fill_points_head(sweep, mode, head);
+  fill_points_head(sweep, config, head);
   head.num_points = 0;  // the arrays empty: num_points is the head's last field, patched below
   head.x.clear();
   head.y.clear();

@@ -86,6 +86,32 @@ struct InputSlot {
 
 using InputRing = Lane<InputSlot, inputs::kStreamCount>;
 
+// Datagrams on the LiDAR data port that are not VLP-16 data packets (another device, garbage;
+// another Velodyne model is named by the decoder instead): counted with their sizes and first
+// senders by the input thread, read by the publisher for the log. Lock-free.
+struct ForeignDatagrams {
+  static constexpr std::size_t kSenders = 4;
+  std::atomic<std::uint64_t> count{0};
+  std::atomic<std::uint32_t> min_size{~0U}, max_size{0};
+  std::array<std::atomic<std::uint64_t>, kSenders> senders{};  // IPv4 << 16 | port; 0: free
+  std::atomic<std::uint64_t> from_others{0};                   // from senders past the first four
+  void add(std::size_t size, std::uint64_t sender) noexcept {
+    count.fetch_add(1, std::memory_order_relaxed);
+    const auto n = static_cast<std::uint32_t>(size);
+    if (n < min_size.load(std::memory_order_relaxed)) min_size.store(n, std::memory_order_relaxed);
+    if (n > max_size.load(std::memory_order_relaxed)) max_size.store(n, std::memory_order_relaxed);
+    for (auto& s : senders) {  // one writer: a plain check-then-store
+      const std::uint64_t known = s.load(std::memory_order_relaxed);
+      if (known == sender) return;
+      if (known == 0) {
+        s.store(sender, std::memory_order_relaxed);
+        return;
+      }
+    }
+    from_others.fetch_add(1, std::memory_order_relaxed);
+  }
+};
+
 // One input source with its reader thread's ring and what that thread counted.
 struct InputLane {
   std::unique_ptr<inputs::InputSource> source;
@@ -98,6 +124,9 @@ struct InputLane {
   std::atomic<bool> done{false};
   // Copied from the source's counters by the reader, for the status.
   std::atomic<std::uint64_t> oversize{0}, errors{0}, disconnects{0}, rejected_sources{0}, kernel_drops{0};
+  // Bit 1 << stream for each serial stream whose device is not open now (missing, refused).
+  std::atomic<std::uint8_t> closed_streams{0};
+  ForeignDatagrams foreign;  // the LiDAR lane's
 };
 
 struct TrajectoryItem {
@@ -145,6 +174,8 @@ struct Pipeline {
   Ring<TrajectoryItem> trajectories_in;     // publisher → processing
   Ring<TrajectoryItem> trajectories_out;    // processing → publisher (to free)
   std::unique_ptr<Lane<InputSlot>> record;  // processing → recorder, when recording
+  std::string record_dir;                   // its folder (set before the threads start)
+  std::atomic<bool> record_failed{false};   // the recorder stopped on an error (logged)
   std::atomic<bool> processing_done{false}, publishing_done{false};
   // The processing thread is about to wait for input, or waits: an as-fast-as-possible
   // replay's reader then wakes it at once instead of at the end of its batch.

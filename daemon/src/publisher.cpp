@@ -3,8 +3,11 @@
 #include <poll.h>
 #include <systemd/sd-daemon.h>
 
+#include <limits>
+
 #include "realtime.hpp"
 #include "trajroi/host/clock.hpp"
+#include "trajroi/pipeline/pose_words.hpp"
 #include "trajroi/status_t.hpp"
 
 namespace trajroi::daemon {
@@ -19,7 +22,7 @@ Publisher::Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, boo
       trajectories_(pipeline, reloader),
       latency_(pipeline.config.logging.warning_interval_s, !pipeline.exact),
       health_(pipeline.config, !replay, start_steady_ns_),
-      sweep_warn_limit_(pipeline.config.logging.warning_interval_s) {
+      sweep_warnings_(pipeline.config.logging.warning_interval_s) {
   // Here, before the loops start: subscribing opens the receive socket (through liblcm, its
   // self test can take seconds), which must not hold up the publishing loop. For udpm://, the
   // outlet's start-up probe has already said whether this process's multicast comes back.
@@ -59,13 +62,20 @@ void Publisher::publish_sweep(const pipeline::Sweep& s) {
       latency_.add(timing, sent_ns);
     }
   } else {
-    log::warn_limited(sweep_warn_limit_, "sweep " + std::to_string(s.index) + " withheld: no valid pose (" +
-                                             pose::describe(s.pose_status, s.pose_measured, s.pose_limit) + ")");
+    // Each reason said as it first appears, its repeats summarised (log::ReasonLimiter).
+    sweep_warnings_.warn(static_cast<std::uint32_t>(s.pose_status),
+                         "sweep " + std::to_string(s.index) + " withheld: no valid pose (" +
+                             pipeline::pose_reason(s.pose_status, s.pose_measured, s.pose_limit, config_) + ")",
+                         dequeued_ns);
   }
   latency_.add_processing(static_cast<double>(s.processing_ns) * 1e-6);
 }
 
 void Publisher::publish_status(const StatusSnapshot& s) {
+  // Faults said when they start and end; the state in words for systemd and the message.
+  const std::vector<HealthLine> lines = health_.update(s);
+  const bool gnss = pipeline::uses_gnss(config_.pose_source);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
   trajroi::status_t m;
   m.wall_time_ns = host::realtime_ns();
   m.uptime_s = static_cast<double>(s.steady_ns - start_steady_ns_) * 1e-9;
@@ -82,11 +92,14 @@ void Publisher::publish_status(const StatusSnapshot& s) {
   m.points_in = static_cast<std::int64_t>(s.processor.points_in);
   m.points_kept = static_cast<std::int64_t>(s.processor.points_kept);
   m.ring_drops = static_cast<std::int64_t>(s.ring_drops());
+  m.state = health_.state();
+  m.pose_source = std::string(pipeline::pose_source_name(config_.pose_source));
   m.pose_valid = s.pose_valid;
-  m.pose_status = std::string(pose::to_string(s.pose_status));
-  m.pose_age_s = s.pose_age_s;
-  m.fix_type = static_cast<std::int8_t>(s.fix_type);
-  m.h_acc_m = s.h_acc_m;
+  m.pose_status = pipeline::pose_reason(s.pose_status, s.pose_measured, s.pose_limit, config_);
+  m.pose_age_s = config_.pose_source == PoseSource::kFixed ? nan : s.pose_age_s;
+  m.fix_type = gnss ? static_cast<std::int8_t>(s.fix_type) : trajroi::pose_t::NOT_APPLICABLE;
+  m.h_acc_m = gnss && s.pose_age_s >= 0.0 ? s.h_acc_m : nan;
+  m.recording = pipeline_.record_dir;
   m.host_minus_gnss_utc_s = s.host_minus_gnss_utc_s;
   m.lidar_pps_status = s.lidar_pps_status;
   m.lidar_gprmc_valid = s.lidar_gprmc_valid;
@@ -108,23 +121,32 @@ void Publisher::publish_status(const StatusSnapshot& s) {
   const double kept_pct =
       m.points_in > 0 ? 100.0 * static_cast<double>(m.points_kept) / static_cast<double>(m.points_in) : 0.0;
   log::info(
-      "status: sweeps {} published {} withheld {} | points in {} kept {} ({:.1f} %) | latency p50 {:.2f} p99 "
-      "{:.2f} ms | drops {} | lost packets {} | pose {} (fix {}, age {:.2f} s) | trajectory {}",
-      m.sweeps, m.sweeps_published, m.sweeps_without_pose, m.points_in, m.points_kept, kept_pct, m.latency_ms_p50,
-      m.latency_ms_p99, m.ring_drops, m.lost_packets, m.pose_status, static_cast<int>(m.fix_type), m.pose_age_s,
-      m.trajectory_id);
-  // Faults said when they start and end; systemd told the state in words.
-  for (const HealthLine& line : health_.update(s)) {
+      "status: {} | sweeps {} published {} withheld {} | points in {} kept {} ({:.1f} %) | latency p50 {:.2f} p99 "
+      "{:.2f} ms | drops {} | lost packets {} | {} | trajectory {}{}",
+      m.state, m.sweeps, m.sweeps_published, m.sweeps_without_pose, m.points_in, m.points_kept, kept_pct,
+      m.latency_ms_p50, m.latency_ms_p99, m.ring_drops, m.lost_packets, pose_inputs_text(s, config_), m.trajectory_id,
+      recording_text());
+  for (const HealthLine& line : lines) {
     if (line.level == HealthLine::Level::kWarning) {
       log::warn("{}", line.text);
     } else {
       log::info("{}", line.text);
     }
   }
+  sweep_warnings_.flush(host::monotonic_ns());
   if (!s.final) sd_notify(0, ("STATUS=" + health_.state()).c_str());
   latency_.end_window();
   last_status_ = s;
   minute_.on_status(s, latency_);
+}
+
+std::string Publisher::recording_text() const {
+  if (pipeline_.record_dir.empty()) return {};
+  const std::uint64_t drops = pipeline_.record ? pipeline_.record->dropped() : 0;
+  if (pipeline_.record_failed.load(std::memory_order_relaxed))
+    return " | recording into " + pipeline_.record_dir + " STOPPED (see the error above)";
+  return " | recording into " + pipeline_.record_dir +
+         (drops > 0 ? " (" + std::to_string(drops) + " items dropped)" : std::string());
 }
 
 void Publisher::publish_pending_sweeps() {

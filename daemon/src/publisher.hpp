@@ -36,6 +36,8 @@ class Publisher {
   // Every sweep in the ring, oldest first.
   void publish_pending_sweeps();
   void publish_status(const StatusSnapshot& s);
+  // " | recording into DIR", or "" when not recording.
+  [[nodiscard]] std::string recording_text() const;
 
   Pipeline& pipeline_;
   Outlet& outlet_;
@@ -48,7 +50,7 @@ class Publisher {
   HealthMonitor health_;
   MinuteLine minute_;
   StatusSnapshot last_status_;
-  log::RateLimited sweep_warn_limit_;  // withheld sweeps
+  log::ReasonLimiter sweep_warnings_;  // withheld sweeps, by reason
 };
 
 }  // namespace trajroi::daemon

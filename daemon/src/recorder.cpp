@@ -60,7 +60,8 @@ void recorder_loop(Pipeline& pipeline, const std::filesystem::path& dir) {
     record_to(pipeline, dir);
   } catch (const std::exception& e) {
     // The pipeline goes on; what cannot be recorded fills the record ring, counted.
-    log::error("--record stopped: {}", e.what());
+    pipeline.record_failed.store(true, std::memory_order_relaxed);
+    log::error("--record stopped: {}; the pipeline goes on, unrecorded", e.what());
   }
 }
 

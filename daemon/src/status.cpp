@@ -59,8 +59,23 @@ void fill_snapshot(const pipeline::SweepProcessor& p, const Pipeline& pipeline, 
   s.lost_packets = l.lost_packets;
   s.decode_errors = l.rejected_total();
   const pipeline::Sweep& current = p.current();
-  s.pose_valid = current.pose_status == pose::PoseStatus::kValid;
-  s.pose_status = current.pose_status;
+  constexpr std::int64_t kRecent_ns = 1'000'000'000;
+  if (p.counters().sweeps > 0 && last_receive_ns - current.start_ns < kRecent_ns) {
+    s.pose_status = current.pose_status;
+    s.pose_measured = current.pose_measured;
+    s.pose_limit = current.pose_limit;
+  } else {  // no sweep lately: the pose inputs' state at the newest input
+    const pose::PoseQuery q = p.poses().pose_at(last_receive_ns);
+    s.pose_status = q.status;
+    s.pose_measured = q.measured;
+    s.pose_limit = q.limit;
+  }
+  s.pose_valid = s.pose_status == pose::PoseStatus::kValid;
+  s.heading_source = pipeline.config.pose_source == PoseSource::kFixed
+                         ? std::string_view("fixed")
+                         : pose_input::to_string(p.pose_input().heading_source());
+  const auto attitude_ns = p.poses().newest_attitude_ns();
+  s.attitude_age_s = attitude_ns ? std::max(0.0, static_cast<double>(last_receive_ns - *attitude_ns) * 1e-9) : -1.0;
   const pose::GnssFix* fix = p.poses().newest_fix();
   // Against the newest input's receive time (a replay's clock, not the wall's); a fix stamped
   // after it (the delay configured too small) is not older than the input: age 0.
@@ -80,7 +95,22 @@ void fill_snapshot(const pipeline::SweepProcessor& p, const Pipeline& pipeline, 
   s.model_reason[n] = '\0';
 
   s.counters.fill(0);
+  s.closed_streams = 0;
+  s.foreign_min_size = ~0U;
+  s.foreign_max_size = 0;
+  s.foreign_senders.fill(0);
+  s.foreign_from_others = 0;
   for (const auto& lane : pipeline.inputs) {
+    s.closed_streams |= lane->closed_streams.load(std::memory_order_relaxed);
+    const ForeignDatagrams& f = lane->foreign;
+    if (const std::uint64_t count = f.count.load(std::memory_order_relaxed); count > 0) {
+      s[C::kLidarNotVlp16] += count;
+      s.foreign_min_size = std::min(s.foreign_min_size, f.min_size.load(std::memory_order_relaxed));
+      s.foreign_max_size = std::max(s.foreign_max_size, f.max_size.load(std::memory_order_relaxed));
+      for (std::size_t i = 0; i < s.foreign_senders.size(); ++i)
+        s.foreign_senders[i] = f.senders[i].load(std::memory_order_relaxed);
+      s.foreign_from_others += f.from_others.load(std::memory_order_relaxed);
+    }
     const auto drops = [&lane](inputs::Stream st) { return lane->ring->dropped(static_cast<std::size_t>(st)); };
     s[C::kRingDropsLidar] += drops(inputs::Stream::kLidarData) + drops(inputs::Stream::kLidarPosition);
     s[C::kRingDropsGnss] += drops(inputs::Stream::kGnss);
@@ -142,6 +172,13 @@ void fill_snapshot(const pipeline::SweepProcessor& p, const Pipeline& pipeline, 
   s[C::kTrajectorySwaps] = p.counters().trajectory_swaps;
   s[C::kTrajectoryProjectionReacquired] = p.counters().projection_reacquired;
   s[C::kLidarDecodedAhead] = l.decoded_ahead;
+  const auto sniffed = [&s](Counter first, const framing::SnifferCounters& c) {
+    s.counters[at(first)] = c.nmea_sentences;
+    s.counters[at(first) + 1] = c.vn100_ascii_sentences;
+    s.counters[at(first) + 2] = c.rtcm3_frames;
+  };
+  sniffed(C::kGnssNmea, in.gnss_sniffed());
+  sniffed(C::kImuNmea, in.imu_sniffed());
 }
 
 }  // namespace trajroi::daemon

@@ -76,7 +76,14 @@ struct Pipeline;
   X(kSweepsPointsTruncated, "sweeps.points_truncated")                               \
   X(kTrajectorySwaps, "trajectory.swaps")                                            \
   X(kTrajectoryProjectionReacquired, "trajectory.projection_reacquired")             \
-  X(kLidarDecodedAhead, "lidar.decoded_ahead")
+  X(kLidarDecodedAhead, "lidar.decoded_ahead")                                       \
+  X(kLidarNotVlp16, "lidar.not_vlp16_datagrams")                                     \
+  X(kGnssNmea, "gnss.nmea_sentences")                                                \
+  X(kGnssVnAscii, "gnss.vn100_ascii_sentences")                                      \
+  X(kGnssRtcm3, "gnss.rtcm3_frames")                                                 \
+  X(kImuNmea, "imu.nmea_sentences")                                                  \
+  X(kImuVnAscii, "imu.vn100_ascii_sentences")                                        \
+  X(kImuRtcm3, "imu.rtcm3_frames")
 
 enum class Counter : std::uint16_t {
 #define TRAJROI_COUNTER_ID(id, name) id,
@@ -96,11 +103,21 @@ struct StatusSnapshot {
   std::int32_t trajectory_id = 0;
   pipeline::ProcessorCounters processor;
   std::uint64_t lidar_packets = 0, position_packets = 0, lost_packets = 0, decode_errors = 0;
+  // The pose at the newest sweep, or at the newest input when no sweep came in the last second
+  // (so that the pose inputs' state shows without LiDAR data), with the failed gate's figures.
   bool pose_valid = false;
   pose::PoseStatus pose_status = pose::PoseStatus::kNoGnss;
-  double pose_age_s = -1.0;
+  double pose_measured = 0.0, pose_limit = 0.0;
+  double pose_age_s = -1.0;      // newest input − newest fix or localization pose (−1: none)
+  double attitude_age_s = -1.0;  // newest input − newest attitude (−1: none)
   std::uint8_t fix_type = 0;
   double h_acc_m = 0.0;
+  std::string_view heading_source = "none";
+  std::uint8_t closed_streams = 0;  // bit 1 << inputs::Stream: a serial device not open now
+  // The LiDAR data port's datagrams that are not VLP-16 packets: sizes and first senders.
+  std::uint32_t foreign_min_size = 0, foreign_max_size = 0;
+  std::array<std::uint64_t, 4> foreign_senders{};  // IPv4 << 16 | port; 0: none
+  std::uint64_t foreign_from_others = 0;
   bool final = false;  // the last one: the input has ended
   // For the fault lines (health.hpp): the robot's distance to the active trajectory at the
   // last sweep with a pose (NaN before), and the model check's last rejection ("" if none).

@@ -23,18 +23,33 @@ void TrajectoryIntake::on_message(std::span<const std::uint8_t> bytes, const std
     return;
   }
   ++accepted_;
-  log::info("trajectory {} accepted: {} waypoints, {:.1f} m; active from the next sweep", check.trajectory->id,
-            check.trajectory->trajectory.waypoints().size(), check.trajectory->trajectory.length_m());
+  const std::int32_t sent = check.trajectory->id;
+  check.trajectory->id = next_id(sent);
+  const std::string renumbered = check.trajectory->id == sent ? std::string()
+                                                              : " (its message said id " + std::to_string(sent) +
+                                                                    ", not above the last id given: each accepted "
+                                                                    "trajectory gets an id above every earlier one)";
+  log::info("trajectory {} accepted from {}: {} waypoints, {:.1f} m; active from the next sweep{}",
+            check.trajectory->id, channel, check.trajectory->trajectory.waypoints().size(),
+            check.trajectory->trajectory.length_m(), renumbered);
   offer(std::move(check.trajectory));
+}
+
+std::int32_t TrajectoryIntake::next_id(std::int32_t wanted) {
+  last_id_ = wanted > last_id_ ? wanted : last_id_ + 1;
+  return last_id_;
 }
 
 void TrajectoryIntake::take_reloads() {
   if (reloader_ == nullptr) return;
   for (Reloader::Result& r : reloader_->take()) {
     if (r.trajectory) {
-      offer(std::move(r.trajectory));
+      r.trajectory->id = next_id(0);
       ++reloads_;
-      log::info("SIGHUP: trajectory reloaded from {}; active from the next sweep", reloader_->file().string());
+      log::info("SIGHUP: trajectory {} reloaded from {}: {} waypoints, {:.1f} m; active from the next sweep",
+                r.trajectory->id, reloader_->file().string(), r.trajectory->trajectory.waypoints().size(),
+                r.trajectory->trajectory.length_m());
+      offer(std::move(r.trajectory));
     } else {
       ++reload_errors_;
       log::error("SIGHUP: trajectory not reloaded, the active one stays: {}", r.error);

@@ -3,6 +3,9 @@
 // The publisher's trajectory intake: trajectory messages from LCM checked (decode_trajectory)
 // and SIGHUP reloads taken from the Reloader, each accepted one offered to the processing
 // thread (active from its next sweep), every outcome counted for the status and logged.
+// Every accepted trajectory gets an id above every earlier one (the configured file's at start
+// is 0): a message's own id when it is above them, else the next; a SIGHUP reload the next. So
+// points_t and roi_t tell which trajectory each sweep was filtered against.
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -30,12 +33,15 @@ class TrajectoryIntake {
 
  private:
   void offer(std::unique_ptr<pipeline::ActiveTrajectory> trajectory);
+  // The id of the next accepted trajectory: `wanted` when above every earlier id.
+  std::int32_t next_id(std::int32_t wanted);
 
   Pipeline& pipeline_;
   Reloader* reloader_;
   pose::GlobalFrame frame_;
   std::array<std::uint64_t, kTrajectoryRejectCount> rejects_{};
   std::uint64_t accepted_ = 0, reloads_ = 0, reload_errors_ = 0;
+  std::int32_t last_id_ = 0;     // the configured file's at start
   log::RateLimited warn_limit_;  // rejected messages: never hidden by other warnings
 };
 

@@ -23,6 +23,7 @@
 #include "trajroi/configure/receiver_config.hpp"
 #include "trajroi/inputs/live_input.hpp"
 #include "trajroi/inputs/recorded_input.hpp"
+#include "trajroi/inputs/run_merger.hpp"
 #include "trajroi/roi/cpu.hpp"
 
 namespace trajroi::daemon {
@@ -253,6 +254,11 @@ int run_daemon(const DaemonConfig& config, std::unique_ptr<pipeline::ActiveTraje
       log::critical("--record {}: {}", options.record->string(), ec.message());
       return 1;
     }
+    pipeline.record_dir = options.record->string();
+    log::info("recording every raw input into {} ({}, {}, {}{}; replay it with trajroid --replay {})",
+              pipeline.record_dir, inputs::kLidarFile, inputs::kGnssFile, inputs::kImuFile,
+              config.pose_source == PoseSource::kLcm ? std::string(", ") + inputs::kPoseFile : std::string(),
+              pipeline.record_dir);
   }
   if (config.realtime.lock_memory) {
     if (const std::string w = lock_memory(); !w.empty()) log::warn("{}", w);

@@ -77,16 +77,18 @@ TEST(TrajroidControl, TrajectoryOverLcmSighupAndSigterm) {
       EXPECT_EQ(m.trajectory_id, idx < first_new ? 0 : 7) << idx;
   }
 
-  // SIGHUP: the configured file again, from a later sweep on.
+  // SIGHUP: the configured file again, from a later sweep on, under a new id (the next above 7).
   child.signal(SIGHUP);
   ASSERT_TRUE(listener.wait_for(
       [&] {
-        return listener.points.rbegin()->first > first_new && listener.points.rbegin()->second.trajectory_id == 0;
+        return listener.points.rbegin()->first > first_new && listener.points.rbegin()->second.trajectory_id == 8;
       },
       seconds(10)));
+  EXPECT_NE(slurp(run / (prefix + ".log")).find("SIGHUP: trajectory 8 reloaded from " + trajectory_file.string()),
+            std::string::npos);
 
   // Malformed files on SIGHUP: each refused with its reason in the log, the active
-  // trajectory (the configured one, id 0) stays.
+  // trajectory (the reloaded one, id 8) stays.
   const std::string good = slurp(trajectory_file);
   std::string million;
   million.reserve(14'000'000);
@@ -118,7 +120,7 @@ TEST(TrajroidControl, TrajectoryOverLcmSighupAndSigterm) {
     const auto refused = text_now.rfind("SIGHUP: trajectory not reloaded");
     EXPECT_NE(text_now.find(bad[i].second, refused), std::string::npos) << text_now.substr(refused);
     std::lock_guard<std::mutex> lock(listener.mutex);
-    EXPECT_EQ(listener.points.rbegin()->second.trajectory_id, 0);
+    EXPECT_EQ(listener.points.rbegin()->second.trajectory_id, 8);
   }
   std::ofstream(trajectory_file, std::ios::trunc) << good;
 

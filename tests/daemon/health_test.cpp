@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "trajroi/inputs/input_source.hpp"
 #include "trajroi/vlp16/packet.hpp"
 
 namespace {
@@ -100,7 +101,9 @@ TEST(Health, NoLidarDatagramsAreNamedWithThePortWithinFiveSecondsAndTheirReturnT
                   live_config(), 8, [](StatusSnapshot&, int) {}, false)
                   .lines.empty());
   // The state while waiting.
-  EXPECT_EQ(run(live_config(), 3, [](StatusSnapshot&, int) {}).state, "waiting for LiDAR data on UDP port 2368");
+  // The state while waiting: every input the pose source uses, by name.
+  EXPECT_EQ(run(live_config(), 3, [](StatusSnapshot&, int) {}).state,
+            "waiting for LiDAR data on UDP port 2368; GNSS: no bytes from /dev/gnss; IMU: no bytes from /dev/imu");
 }
 
 TEST(Health, DatagramsOnlyFromAnotherSenderNameTheSensorAddress) {
@@ -129,7 +132,9 @@ TEST(Health, BytesButNoFramesSayWrongBaudRateWithTheFigures) {
     s[Counter::kGnssFrames] -= 10;
     s[Counter::kPoseFixes] -= 10;
   });
-  const int at = said.first("gnss: 3000 bytes in 3 s from /dev/gnss at 115200 baud but no UBX frame: wrong baud rate?");
+  const int at = said.first(
+      "gnss: 3000 bytes in 3 s from /dev/gnss at 115200 baud but no UBX frame, and no NMEA, VN-100 ASCII or RTCM3 "
+      "either: wrong baud rate? (gnss.baud)");
   EXPECT_GE(at, 1) << said.all();
   EXPECT_LE(at, 5);
 }
@@ -202,7 +207,133 @@ TEST(Health, TheStateSaysWhyThereIsNoPose) {
     s.pose_valid = false;
     s.pose_status = trajroi::pose::PoseStatus::kNoGnss;
   });
-  EXPECT_EQ(said.state, "no valid pose: no GNSS fix yet");
+  EXPECT_EQ(said.state, "no valid pose: no GNSS fix yet from gnss.device /dev/gnss");
+}
+
+// What a port carries instead of its binary protocol is named, with the remedy.
+TEST(Health, NmeaVectorNavAsciiAndRtcm3AreNamedNotBlamedOnTheBaudRate) {
+  Said said = run(live_config(), 5, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s[Counter::kGnssFrames] -= 10;
+    s[Counter::kPoseFixes] -= 10;
+    s[Counter::kGnssNmea] += 8;
+    s[Counter::kImuFrames] -= 40;
+    s[Counter::kPoseAttitudes] -= 40;
+    s[Counter::kImuVnAscii] += 40;
+  });
+  EXPECT_EQ(said.first("gnss: NMEA text, no UBX: 24 NMEA sentences and no UBX frame in 3 s from /dev/gnss: enable UBX "
+                       "output (UBX-NAV-PVT) on this port, or set gnss.configure: true"),
+            3)
+      << said.all();
+  EXPECT_EQ(said.first("imu: VN-100 ASCII output, no binary: 120 $VN sentences and no binary frame in 3 s from "
+                       "/dev/imu: enable binary output (register 75) on this port, or set imu.configure: true"),
+            3)
+      << said.all();
+  EXPECT_EQ(said.first("wrong baud rate"), -1) << said.all();
+  EXPECT_EQ(said.state, "GNSS: NMEA text, no UBX, from /dev/gnss; IMU: VN-100 ASCII output, no binary, from /dev/imu");
+  said = run(live_config(), 4, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s[Counter::kGnssFrames] -= 10;
+    s[Counter::kPoseFixes] -= 10;
+    s[Counter::kGnssRtcm3] += 3;
+  });
+  EXPECT_EQ(said.first("gnss: RTCM3 corrections, no UBX: 9 RTCM3 frames and no UBX frame in 3 s from /dev/gnss"), 3)
+      << said.all();
+}
+
+// A device that cannot be opened is said by its input (with errno); the monitor does not add
+// "no bytes" for it, and the state says it is waited for.
+TEST(Health, AClosedDeviceIsWaitedForNotCalledSilent) {
+  const Said said = run(live_config(), 6, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s[Counter::kGnssBytes] -= 1000;
+    s[Counter::kGnssFrames] -= 10;
+    s[Counter::kPoseFixes] -= 10;
+    s.closed_streams = 1U << static_cast<unsigned>(trajroi::inputs::Stream::kGnss);
+  });
+  EXPECT_EQ(said.first("gnss: no bytes"), -1) << said.all();
+  EXPECT_EQ(said.state, "GNSS: cannot open /dev/gnss; waiting for it");
+}
+
+// Only what the pose source uses is named: a localization's gap is a localization's, never GNSS.
+TEST(Health, ALocalizationsStopReturnAndInvalidPosesAreNamedAndNoGnssIsMentioned) {
+  DaemonConfig c = live_config();
+  c.pose_source = trajroi::daemon::PoseSource::kLcm;
+  c.lcm.pose_input = "LOC";
+  const Said said = run(c, 14, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s[Counter::kGnssBytes] = s[Counter::kGnssFrames] = s[Counter::kPoseFixes] = 0;
+    s[Counter::kImuBytes] = s[Counter::kImuFrames] = s[Counter::kPoseAttitudes] = 0;
+    if (t <= 3 || t > 8) s[Counter::kPoseExternal] += 20;  // stops from 4 s to 8 s
+    if (t == 11) s[Counter::kPoseExternalInvalid] += 5;
+    if (t > 4 && t <= 8) {
+      s.pose_valid = false;
+      s.pose_status = trajroi::pose::PoseStatus::kGnssTooOld;
+      s.pose_measured = 1.6;
+      s.pose_limit = 1.5;
+    }
+    if (t == 7) {
+      s.processor.sweeps_filtered -= 10;
+    }
+  });
+  EXPECT_EQ(said.first("localization: no pose_input_t on LOC for 3 s"), 6) << said.all();
+  EXPECT_EQ(said.first("localization: poses arriving on LOC"), 9) << said.all();
+  EXPECT_EQ(said.first("localization: 5 of 65 poses in 3 s on LOC marked invalid"), 11) << said.all();
+  EXPECT_EQ(said.first("localization: no invalid poses on LOC"), 14) << said.all();
+  EXPECT_EQ(said.all().find("gnss"), std::string::npos) << said.all();
+  EXPECT_EQ(said.all().find("imu"), std::string::npos) << said.all();
+  // The state while it is away, in the localization's words.
+  const Said away = run(c, 7, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s.pose_valid = false;
+    s.pose_status = trajroi::pose::PoseStatus::kGnssTooOld;
+    s.pose_measured = 1.6;
+    s.pose_limit = 1.5;
+    if (t <= 2) s[Counter::kPoseExternal] += 20;
+  });
+  EXPECT_EQ(away.state, "localization: no pose_input_t on LOC");
+  const Said late = run(c, 3, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s[Counter::kPoseExternal] += 20;
+    s.pose_valid = false;
+    s.pose_status = trajroi::pose::PoseStatus::kGnssTooOld;
+    s.pose_measured = 1.6;
+    s.pose_limit = 1.5;
+  });
+  EXPECT_EQ(late.state,
+            "no valid pose: newest localization pose too old: 1.600 s > 1.500 s (pose.max_extrapolation_s)");
+}
+
+// Datagrams that are not VLP-16 packets: named with their sizes and senders within 5 s when
+// nothing else comes; summarised once a minute when mixed with the sensor's packets.
+TEST(Health, DatagramsThatAreNotVlp16PacketsAreNamedWithSizesAndSenders) {
+  const auto garbage = [](StatusSnapshot& s) {
+    s[Counter::kLidarNotVlp16] += 500;
+    s.foreign_min_size = 1;
+    s.foreign_max_size = 1500;
+    s.foreign_senders = {(std::uint64_t{0x7F000001} << 16) | 40000, 0, 0, 0};
+  };
+  Said said = run(live_config(), 4, [&](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s.lidar_packets = s.position_packets = 0;
+    s.processor = {};
+    garbage(s);
+  });
+  EXPECT_EQ(said.first("lidar: 500 datagrams in 1 s on UDP port 2368 and none a VLP-16 data packet (1–1500 bytes; a "
+                       "VLP-16 sends 1206; from 127.0.0.1:40000)"),
+            1)
+      << said.all();
+  EXPECT_EQ(said.first("lidar: no datagrams"), -1) << said.all();
+  EXPECT_EQ(said.state.rfind("LiDAR: no VLP-16 packets on UDP port 2368, only other datagrams", 0), 0) << said.state;
+  said = run(live_config(), 61, [&](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    garbage(s);
+  });
+  EXPECT_EQ(said.first("lidar: 30000 datagrams in the last 60 s on UDP port 2368 were not VLP-16 data packets, beside "
+                       "45240 packets (1–1500 bytes; from 127.0.0.1:40000)"),
+            60)
+      << said.all();
+  EXPECT_EQ(said.lines.size(), 1U) << said.all();
 }
 
 }  // namespace

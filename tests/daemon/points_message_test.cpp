@@ -53,9 +53,15 @@ trajroi::pipeline::Sweep sweep_with(std::size_t n) {
   return s;
 }
 
+trajroi::daemon::DaemonConfig config_with(PoseMode mode) {
+  trajroi::daemon::DaemonConfig c;
+  c.pose_mode = mode;
+  return c;
+}
+
 std::vector<std::uint8_t> reference_bytes(const trajroi::pipeline::Sweep& s, PoseMode mode) {
   trajroi::points_t m;
-  trajroi::daemon::fill_points(s, mode, m);
+  trajroi::daemon::fill_points(s, config_with(mode), m);
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
   EXPECT_EQ(m.encode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
   return bytes;
@@ -70,7 +76,7 @@ TEST(PointsMessage, TheDirectEncoderWritesLcmsBytes) {
                               std::size_t{33}, std::size_t{57'600}, std::size_t{3}}) {
     for (const PoseMode mode : {PoseMode::kPerFiring, PoseMode::kPerSweep}) {
       const trajroi::pipeline::Sweep s = sweep_with(n);
-      trajroi::daemon::encode_points(s, mode, head, bytes);
+      trajroi::daemon::encode_points(s, config_with(mode), head, bytes);
       ASSERT_EQ(bytes, reference_bytes(s, mode)) << n << " points";
     }
   }
@@ -80,7 +86,7 @@ TEST(PointsMessage, TheBytesDecodeToTheSweep) {
   const trajroi::pipeline::Sweep s = sweep_with(101);
   trajroi::points_t head;
   std::vector<std::uint8_t> bytes;
-  trajroi::daemon::encode_points(s, PoseMode::kPerFiring, head, bytes);
+  trajroi::daemon::encode_points(s, config_with(PoseMode::kPerFiring), head, bytes);
   trajroi::points_t m;
   ASSERT_EQ(m.decode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
   EXPECT_EQ(m.sweep_index, 41);

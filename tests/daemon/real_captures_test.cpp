@@ -226,11 +226,34 @@ TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKee
   const trajroi::status_t& last = listener.statuses.back();
   EXPECT_EQ(last.lost_packets, 0) << rig.logs();
   EXPECT_EQ(last.decode_errors, 0) << rig.logs();
-  for (const trajroi::status_t& s : listener.statuses)
-    EXPECT_TRUE(s.pose_age_s >= 0.0 || s.pose_age_s == -1.0) << "pose age " << s.pose_age_s;  // never negative
-  EXPECT_EQ(last.lidar_pps_status, 2);                                                        // locked
-  EXPECT_EQ(last.lidar_gprmc_valid, 1);                                                       // 'A'
-  if (source == std::string("gnss_imu") || source == std::string("gnss")) {
+  const bool gnss = source == std::string("gnss_imu") || source == std::string("gnss");
+  for (const trajroi::status_t& s : listener.statuses) {
+    // Never negative; not applicable to a fixed pose; a GNSS fix's fields only for GNSS sources.
+    if (source == std::string("fixed")) {
+      EXPECT_TRUE(std::isnan(s.pose_age_s)) << "pose age " << s.pose_age_s;
+    } else {
+      EXPECT_TRUE(s.pose_age_s >= 0.0 || s.pose_age_s == -1.0) << "pose age " << s.pose_age_s;
+    }
+    EXPECT_EQ(s.pose_source, source == std::string("lcm") ? std::string("localization") : std::string(source));
+    if (!gnss) {
+      EXPECT_EQ(s.fix_type, trajroi::pose_t::NOT_APPLICABLE);
+      EXPECT_TRUE(std::isnan(s.h_acc_m));
+    }
+  }
+  for (const auto& [index, m] : listener.points) {  // the lock is held
+    EXPECT_EQ(m.pose.pose_source, last.pose_source);
+    if (!gnss) {
+      EXPECT_EQ(m.pose.fix_type, trajroi::pose_t::NOT_APPLICABLE) << index;
+      EXPECT_FALSE(m.pose.rtk_fixed) << index;
+      EXPECT_TRUE(std::isnan(m.pose.h_acc_m)) << index;
+    } else {
+      EXPECT_GE(m.pose.fix_type, 3) << index;
+      EXPECT_GT(m.pose.h_acc_m, 0.0) << index;
+    }
+  }
+  EXPECT_EQ(last.lidar_pps_status, 2);   // locked
+  EXPECT_EQ(last.lidar_gprmc_valid, 1);  // 'A'
+  if (gnss) {
     // The receiver's log is from 2021-06-10: the host clock is years ahead of its GNSS time,
     // reported and warned.
     EXPECT_GT(last.host_minus_gnss_utc_s, 1e8);
@@ -316,10 +339,13 @@ TEST(LiveFaults, BytesThatNeverFrameSayWrongBaudRate) {
   Child daemon(rig.daemon_args(), rig.daemon_log);
   Child feeder(
       TRAJROI_CLI,
-      {"feed", "--vn100", noise.string(), "--imu-link", rig.gnss_link.string(), "--vn100-rate", "200", "--until", "8"},
+      {"feed", "--vn100", noise.string(), "--imu-link", rig.gnss_link.string(), "--vn100-rate", "20", "--until", "8"},
       rig.feed_log);
-  EXPECT_LOGGED_WITHIN_5S(rig, "from " + rig.gnss_link.string() + " at 115200 baud but no UBX frame: wrong baud rate?",
-                          start);
+  EXPECT_LOGGED_WITHIN_5S(
+      rig,
+      "from " + rig.gnss_link.string() +
+          " at 115200 baud but no UBX frame, and no NMEA, VN-100 ASCII or RTCM3 either: wrong baud rate?",
+      start);
   rig.stop(daemon);
 }
 
@@ -364,7 +390,9 @@ TEST(LiveFaults, ARejectedTrajectoryMessageIsSaidAmidWithheldSweepWarnings) {
   const auto start = std::chrono::steady_clock::now();
   Child daemon(rig.daemon_args(), rig.daemon_log);
   Child feeder(TRAJROI_CLI, rig.pcap_feed(pcap, "0.5"), rig.feed_log);
-  ASSERT_GE(seconds_until_logged(rig.daemon_log, "withheld: no valid pose (no GNSS fix yet)", start, seconds(5)), 0.0)
+  ASSERT_GE(seconds_until_logged(rig.daemon_log, "withheld: no valid pose (no GNSS fix yet from gnss.device ", start,
+                                 seconds(5)),
+            0.0)
       << rig.logs();
   trajroi::trajectory_t bad;
   bad.id = 0;  // ids are > 0

@@ -51,6 +51,7 @@ UdpInput::Next UdpInput::next(InputItem& item, std::chrono::milliseconds timeout
   item.receive_ns = d.receive_time_ns - (host::realtime_ns() - host::monotonic_ns());
   item.stream = d.destination_port == udp_->position_port() ? Stream::kLidarPosition : Stream::kLidarData;
   item.bytes = d.payload;
+  item.sender = d.sender;
   ++items_;
   return Next::kItem;
 }
@@ -66,6 +67,7 @@ InputCounters SerialInput::counters() const noexcept {
   InputCounters c;
   c.items = items_;
   c.disconnects = port_->counters().disconnects;
+  if (!port_->is_open()) c.closed_streams = static_cast<std::uint8_t>(1U << static_cast<unsigned>(stream_));
   return c;
 }
 

@@ -46,12 +46,14 @@ void PoseInput::gnss_bytes(std::span<const std::uint8_t> bytes, std::int64_t rec
   // Only while this port has given no UBX frame: a healthy port pays nothing for the check.
   if (ubx_.counters().frames == 0) {
     vn_on_gnss_.feed(bytes, [&](std::span<const std::uint8_t>) { ++counters_.vn100_frames_on_gnss; });
+    gnss_sniffer_.feed(bytes);
   }
 }
 
 void PoseInput::imu_bytes(std::span<const std::uint8_t> bytes, std::int64_t receive_ns) {
   if (vn_.counters().frames == 0) {
     ubx_on_imu_.feed(bytes, [&](const ublox::Message&) { ++counters_.ubx_frames_on_imu; });
+    imu_sniffer_.feed(bytes);
   }
   vn_.feed(bytes, [&](std::span<const std::uint8_t> frame) {
     vn100::Sample sample;

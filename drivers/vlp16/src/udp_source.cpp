@@ -148,6 +148,8 @@ bool UdpSource::deliver(Socket& socket, Datagram& datagram) {
   datagram.payload = std::span<const std::uint8_t>(socket.buffers.data() + i * kBufferBytes,
                                                    std::min<std::size_t>(message.msg_len, kBufferBytes));
   datagram.destination_port = socket.port;
+  const sockaddr_in& from = socket.senders[i];
+  datagram.sender = (static_cast<std::uint64_t>(ntohl(from.sin_addr.s_addr)) << 16) | ntohs(from.sin_port);
   datagram.receive_time_ns = 0;
   for (cmsghdr* c = CMSG_FIRSTHDR(&message.msg_hdr); c != nullptr;
        c = CMSG_NXTHDR(const_cast<msghdr*>(&message.msg_hdr), c)) {

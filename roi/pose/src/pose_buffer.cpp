@@ -37,28 +37,36 @@ std::string_view to_string(PoseStatus status) noexcept {
   return "unknown";
 }
 
-std::string describe(PoseStatus status, double measured, double limit) {
-  char text[160];
+std::string describe(PoseStatus status, double measured, double limit, const PoseWords& words) {
+  char text[200];
+  const auto say = [&text](const char* pattern, auto... args) {
+    std::snprintf(text, sizeof text, pattern, args...);
+    return std::string(text);
+  };
+  const int fix = static_cast<int>(words.fix.size()), fixes = static_cast<int>(words.fixes.size());
+  const int attitude = static_cast<int>(words.attitude.size()), attitudes = static_cast<int>(words.attitudes.size());
   switch (status) {
+    case PoseStatus::kNoGnss:
+      return say("no %.*s yet", fix, words.fix.data());
+    case PoseStatus::kNoAttitude:
+      return say("no %.*s yet", attitude, words.attitude.data());
     case PoseStatus::kFixTypeTooLow:
-      std::snprintf(text, sizeof text, "GNSS fix type %.0f < minimum %.0f (pose.min_fix_type)", measured, limit);
-      return text;
+      return say("GNSS fix type %.0f < minimum %.0f (pose.min_fix_type)", measured, limit);
+    case PoseStatus::kNoGnssFixOk:
+      return "GNSS fix not flagged gnssFixOK (pose.require_gnss_fix_ok)";
     case PoseStatus::kAccuracyTooLow:
-      std::snprintf(text, sizeof text, "GNSS horizontal accuracy %.2f m > limit %.2f m (pose.max_h_acc_m)", measured,
-                    limit);
-      return text;
+      return say("GNSS horizontal accuracy %.2f m > limit %.2f m (pose.max_h_acc_m)", measured, limit);
     case PoseStatus::kGnssTooOld:
+      return say("newest %.*s too old: %.3f s > %.3f s (pose.max_extrapolation_s)", fix, words.fix.data(), measured,
+                 limit);
     case PoseStatus::kAttitudeTooOld:
-      std::snprintf(text, sizeof text, "%s: %.3f s > %.3f s (pose.max_extrapolation_s)",
-                    status == PoseStatus::kGnssTooOld ? "newest GNSS fix too old" : "newest attitude too old", measured,
-                    limit);
-      return text;
+      return say("newest %.*s too old: %.3f s > %.3f s (pose.max_extrapolation_s)", attitude, words.attitude.data(),
+                 measured, limit);
     case PoseStatus::kGnssGap:
+      return say("gap between %.*s %.3f s > %.3f s (pose.max_gap_s)", fixes, words.fixes.data(), measured, limit);
     case PoseStatus::kAttitudeGap:
-      std::snprintf(text, sizeof text, "%s %.3f s > %.3f s (pose.max_gap_s)",
-                    status == PoseStatus::kGnssGap ? "gap between GNSS fixes" : "gap between attitudes", measured,
-                    limit);
-      return text;
+      return say("gap between %.*s %.3f s > %.3f s (pose.max_gap_s)", attitudes, words.attitudes.data(), measured,
+                 limit);
     default:
       return std::string(to_string(status));
   }

@@ -20,13 +20,14 @@
 
 namespace trajroi::daemon {
 
-void fill_pose(const pipeline::Sweep& sweep, trajroi::pose_t& out);
-void fill_points(const pipeline::Sweep& sweep, PoseMode mode, trajroi::points_t& out);
+// The configuration gives the pose mode and the pose source's words and fields.
+void fill_pose(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::pose_t& out);
+void fill_points(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::points_t& out);
 // The sweep's points_t encoded (LCM's fingerprint and big-endian fields, the bytes
 // points_t::encode writes for fill_points' message) into `out`, resized to the size. The
 // arrays go from the sweep's vectors straight into the bytes: LCM's generated encoder swaps
 // them an element at a time. `head` is scratch for the fields before the arrays.
-void encode_points(const pipeline::Sweep& sweep, PoseMode mode, trajroi::points_t& head,
+void encode_points(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::points_t& head,
                    std::vector<std::uint8_t>& out);
 // The bytes a point takes in that encoding: x, y, z, time offset and one each of intensity,
 // ring and return type.

@@ -33,6 +33,7 @@ struct InputItem {
   Stream stream = Stream::kLidarData;
   std::span<const std::uint8_t> bytes;  // valid until the next call to next()
   std::int64_t receive_ns = 0;          // CLOCK_MONOTONIC (or as recorded)
+  std::uint64_t sender = 0;             // a live datagram's sender: IPv4 address << 16 | port (0: unknown)
 };
 
 // Something the source wants said in the log (a port opened, a device unplugged, a lap).
@@ -49,6 +50,7 @@ struct InputCounters {
   std::uint64_t disconnects = 0;       // serial devices that went away
   std::uint64_t rejected_sources = 0;  // datagrams from an address other than the sensor's
   std::uint64_t kernel_drops = 0;      // datagrams the kernel dropped (full receive buffer)
+  std::uint8_t closed_streams = 0;     // bit 1 << stream: a serial device not open now (retried)
 };
 
 class InputSource {

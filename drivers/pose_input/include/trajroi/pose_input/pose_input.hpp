@@ -27,6 +27,7 @@
 #include <span>
 #include <string_view>
 
+#include "trajroi/framing/protocol_sniffer.hpp"
 #include "trajroi/pose/attitude.hpp"
 #include "trajroi/pose/geodetic.hpp"
 #include "trajroi/pose/pose_buffer.hpp"
@@ -117,6 +118,9 @@ class PoseInput {
   [[nodiscard]] const PoseInputCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const framing::FramerCounters& gnss_framing() const noexcept { return ubx_.counters(); }
   [[nodiscard]] const framing::FramerCounters& imu_framing() const noexcept { return vn_.counters(); }
+  // What else each port carried (NMEA, VectorNav ASCII, RTCM3) while it gave no frame of its own.
+  [[nodiscard]] const framing::SnifferCounters& gnss_sniffed() const noexcept { return gnss_sniffer_.counters(); }
+  [[nodiscard]] const framing::SnifferCounters& imu_sniffed() const noexcept { return imu_sniffer_.counters(); }
   [[nodiscard]] const ClockMap& gnss_clock() const noexcept { return gnss_clock_; }
   [[nodiscard]] const ClockMap& imu_clock() const noexcept { return imu_clock_; }
   [[nodiscard]] HeadingSource heading_source() const noexcept { return heading_source_; }
@@ -140,6 +144,7 @@ class PoseInput {
   // The other sensor's framer on each port, to tell swapped devices from a wrong baud rate.
   ublox::Framer ubx_on_imu_;
   vn100::Framer vn_on_gnss_;
+  framing::ProtocolSniffer gnss_sniffer_, imu_sniffer_;
   ClockMap gnss_clock_;
   ClockMap imu_clock_;
   std::optional<ublox::NavHpposllh> hp_;

@@ -17,6 +17,7 @@ struct Datagram {
   std::span<const std::uint8_t> payload;  // valid until the next call to next()
   std::uint16_t destination_port = 0;
   std::int64_t receive_time_ns = 0;  // CLOCK_REALTIME: kernel receive stamp, or pcap record time
+  std::uint64_t sender = 0;          // the sender's IPv4 address << 16 | its port (0: unknown)
 };
 
 class PacketSource {

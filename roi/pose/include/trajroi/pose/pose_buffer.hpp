@@ -74,9 +74,17 @@ struct PoseQuery {
   double limit = 0.0;
   [[nodiscard]] bool valid() const noexcept { return status == PoseStatus::kValid; }
 };
+// What the two streams of the buffer are called in texts, as the pose source has them: GNSS
+// fixes and attitudes by default; a robot's localization fills both with its poses.
+struct PoseWords {
+  std::string_view fix = "GNSS fix";
+  std::string_view fixes = "GNSS fixes";
+  std::string_view attitude = "attitude";
+  std::string_view attitudes = "attitudes";
+};
 // The status with its figures, e.g. "GNSS horizontal accuracy 2.52 m > limit 0.50 m
-// (pose.max_h_acc_m)"; the status text alone where it has none.
-[[nodiscard]] std::string describe(PoseStatus status, double measured, double limit);
+// (pose.max_h_acc_m)"; the status text alone where it has none; in `words`.
+[[nodiscard]] std::string describe(PoseStatus status, double measured, double limit, const PoseWords& words = {});
 
 // Counts of samples refused on insertion.
 struct PoseBufferCounters {
@@ -106,6 +114,10 @@ class PoseBuffer {
   [[nodiscard]] const PoseGate& gate() const noexcept { return gate_; }
   // The newest fix, or nullptr before the first.
   [[nodiscard]] const GnssFix* newest_fix() const noexcept { return fixes_.size > 0 ? &fixes_.newest() : nullptr; }
+  // The newest attitude's time, or nullopt before the first.
+  [[nodiscard]] std::optional<std::int64_t> newest_attitude_ns() const noexcept {
+    return attitudes_.size > 0 ? std::optional<std::int64_t>(attitudes_.newest().t_ns) : std::nullopt;
+  }
 
  private:
   template <class T>
