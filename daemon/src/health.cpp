@@ -26,6 +26,11 @@ std::uint64_t rejected_total(const StatusSnapshot& s) {
   return n;
 }
 
+// Data packets decoded (status lidar_packets counts the rejected ones too) and position packets.
+std::uint64_t accepted_packets(const StatusSnapshot& s) {
+  return s.lidar_packets - rejected_total(s) + s.position_packets;
+}
+
 }  // namespace
 
 std::string sender_list(const StatusSnapshot& s) {
@@ -98,7 +103,7 @@ void HealthMonitor::lidar(const StatusSnapshot& s, std::vector<HealthLine>& out)
   const DaemonConfig::Lidar& l = config_.lidar;
   const double window = window_s(s);
   // Nothing at all, only from other senders, or only datagrams that are not VLP-16 packets.
-  const std::uint64_t accepted = (s.lidar_packets + s.position_packets) - (base.lidar_packets + base.position_packets);
+  const std::uint64_t accepted = accepted_packets(s) - accepted_packets(base);
   const std::uint64_t foreign = delta(s, C::kLidarRejectedSource);
   const std::uint64_t not_vlp16 = delta(s, C::kLidarNotVlp16);
   const bool silent = live_ && judged(s) && accepted == 0 && foreign == 0 && not_vlp16 == 0 &&
@@ -145,7 +150,8 @@ void HealthMonitor::minute_summary(const StatusSnapshot& s, std::vector<HealthLi
   constexpr std::int64_t kMinute_ns = 60'000'000'000;
   if (s.steady_ns - minute_start_.steady_ns < kMinute_ns && !s.final) return;
   const std::uint64_t other = s[C::kLidarNotVlp16] - minute_start_[C::kLidarNotVlp16];
-  const std::uint64_t packets = s.lidar_packets - minute_start_.lidar_packets;
+  const std::uint64_t packets =
+      (s.lidar_packets - rejected_total(s)) - (minute_start_.lidar_packets - rejected_total(minute_start_));
   if (live_ && other > 0 && packets > 0) {
     out.push_back(
         {HealthLine::Level::kWarning,
@@ -169,7 +175,7 @@ void HealthMonitor::update_state(const StatusSnapshot& s, const StatusSnapshot& 
   } else if (active_[kLidarForeignOnly]) {
     add(sprintf_text("LiDAR: datagrams on UDP port %u only from addresses other than sensor_address %s", l.data_port,
                      l.sensor_address.c_str()));
-  } else if (active_[kLidarSilent] || (live_ && s.lidar_packets == 0)) {
+  } else if (active_[kLidarSilent] || (live_ && accepted_packets(s) == 0)) {
     add(sprintf_text("waiting for LiDAR data on UDP port %u", l.data_port));
   }
   bool pose_input_fault = false;

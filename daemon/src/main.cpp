@@ -7,9 +7,11 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "log.hpp"
@@ -156,6 +158,20 @@ int main(int argc, char** argv) {
   }
   if (check_config) {
     std::printf("%s", describe(config).c_str());
+    // The devices the pose source reads that are not there now: not an error (a USB receiver
+    // may come later), but said, with what the daemon will do.
+    const bool gnss = config.pose_source == PoseSource::kGnssImu || config.pose_source == PoseSource::kGnss;
+    const bool imu = config.pose_source == PoseSource::kGnssImu;
+    for (const auto& [used, key, device] :
+         {std::tuple{gnss, "gnss.device", config.gnss.device}, std::tuple{imu, "imu.device", config.imu.device}}) {
+      std::error_code ec;
+      if (used && !device.empty() && !std::filesystem::exists(device, ec)) {
+        std::printf(
+            "%s: %s %s does not exist now: trajroid will start and wait for it (retried every 0.5 s; "
+            "its log and status say so until it appears)\n",
+            config_file.c_str(), key, device.c_str());
+      }
+    }
     std::printf("%s: configuration OK (trajectory %s: %zu waypoints, %.1f m; pose from %s; LCM %s)\n",
                 config_file.c_str(), config.trajectory_file.c_str(), trajectory->trajectory.waypoints().size(),
                 trajectory->trajectory.length_m(), std::string(to_string(config.pose_source)).c_str(),

@@ -208,6 +208,15 @@ void run_lidar_dump(const LidarDumpOptions& o) {
     if (!read_error.empty()) std::printf("  read error        %s\n", read_error.c_str());
   }
   if (!read_error.empty()) throw std::runtime_error(o.capture + ": " + read_error);
+  // Nothing decoded is a failure, said as one: a script must not take an empty report for a capture.
+  if (c.decoded_packets == 0) {
+    const std::string why =
+        c.data_packets == 0 ? "no datagram to UDP port " + std::to_string(o.data_port) + " (--data-port)"
+        : !decoder.model_check().reason().empty()
+            ? "all " + std::to_string(c.data_packets) + " data packets rejected: " + decoder.model_check().reason()
+            : "all " + std::to_string(c.data_packets) + " data packets rejected (see the counts above)";
+    throw std::runtime_error(o.capture + ": no VLP-16 data packet could be decoded: " + why);
+  }
 }
 
 }  // namespace

@@ -215,14 +215,30 @@ class Watcher {
     std::printf("trajroi watch: %zu sweeps heard", points_heard_);
     if (last_) {
       const auto& s = *last_;
-      std::printf(
-          " of %lld published (%lld withheld without a valid pose); points in %lld, kept %lld; "
-          "latency p50 %.3f ms p99 %.3f ms (last second); ring drops %lld",
-          static_cast<long long>(s.sweeps_published), static_cast<long long>(s.sweeps_without_pose),
-          static_cast<long long>(s.points_in), static_cast<long long>(s.points_kept), s.latency_ms_p50,
-          s.latency_ms_p99, static_cast<long long>(s.ring_drops));
+      std::printf(" of %lld published (%lld withheld without a valid pose); points in %lld, kept %lld; ring drops %lld",
+                  static_cast<long long>(s.sweeps_published), static_cast<long long>(s.sweeps_without_pose),
+                  static_cast<long long>(s.points_in), static_cast<long long>(s.points_kept),
+                  static_cast<long long>(s.ring_drops));
     }
     std::printf("\n");
+    // The daemon's latency over the seconds of this watch that published sweeps (a second with
+    // none has no figure, not 0 ms).
+    if (window_p50_ms_.empty()) {
+      std::printf("trajroi watch: latency: no second with a published sweep heard\n");
+    } else {
+      std::vector<double> p50 = window_p50_ms_;
+      std::nth_element(p50.begin(), p50.begin() + static_cast<std::ptrdiff_t>(p50.size() / 2), p50.end());
+      std::printf(
+          "trajroi watch: latency over the %zu seconds with sweeps (last packet received → points published): "
+          "p50 %.3f ms (the median second's), p99 %.3f ms (the worst second's)\n",
+          window_p50_ms_.size(), p50[p50.size() / 2], *std::max_element(window_p99_ms_.begin(), window_p99_ms_.end()));
+    }
+    if (last_) std::printf("trajroi watch: state at the end: %s\n", last_->state.c_str());
+    if (!scorer_) {
+      std::printf(
+          "trajroi watch: not scored: --run RUN_DIR (the simulated run being replayed) adds precision, recall and "
+          "accuracy of the kept points against the run's truth\n");
+    }
     if (scoring_) scoring_->finish();
     if (not_scored_ > 0) {
       std::printf("trajroi watch: %zu sweeps heard but not scored: the scorer was %zu sweeps behind\n", not_scored_,
@@ -269,14 +285,17 @@ class Watcher {
   }
   void on_roi(const lcm::ReceiveBuffer*, const std::string&, const trajroi::roi_t* m) { rois_[m->sweep_index] = *m; }
   void on_status(const lcm::ReceiveBuffer*, const std::string&, const trajroi::status_t* m) {
+    if (last_ && m->sweeps_published > last_->sweeps_published) {
+      window_p50_ms_.push_back(m->latency_ms_p50);
+      window_p99_ms_.push_back(m->latency_ms_p99);
+    }
     last_ = *m;
     std::printf(
-        "status %6.1f s: sweeps %lld published %lld withheld %lld | kept %lld of %lld | latency p99 %.2f ms | "
-        "drops %lld | pose %s\n",
-        m->uptime_s, static_cast<long long>(m->sweeps), static_cast<long long>(m->sweeps_published),
+        "status %6.1f s: %s | sweeps %lld published %lld withheld %lld | kept %lld of %lld | latency p99 %.2f ms | "
+        "drops %lld\n",
+        m->uptime_s, m->state.c_str(), static_cast<long long>(m->sweeps), static_cast<long long>(m->sweeps_published),
         static_cast<long long>(m->sweeps_without_pose), static_cast<long long>(m->points_kept),
-        static_cast<long long>(m->points_in), m->latency_ms_p99, static_cast<long long>(m->ring_drops),
-        m->pose_status.c_str());
+        static_cast<long long>(m->points_in), m->latency_ms_p99, static_cast<long long>(m->ring_drops));
     std::fflush(stdout);
     if (m->final_status) done_ = true;
   }
@@ -287,6 +306,7 @@ class Watcher {
   std::unique_ptr<ScoringThread> scoring_;  // after scorer_: it ends first
   std::map<std::int64_t, trajroi::roi_t> rois_;
   std::optional<trajroi::status_t> last_;
+  std::vector<double> window_p50_ms_, window_p99_ms_;  // each status second that published sweeps
   std::size_t points_heard_ = 0;
   std::size_t not_scored_ = 0;
   bool done_ = false;

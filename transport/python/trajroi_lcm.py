@@ -6,12 +6,25 @@ module adds what a subscriber needs around them:
 - ``Subscriber(url)``: receives LCM's UDP multicast (udpm://, small and fragmented messages),
   with ``subscribe(channel, handler)`` and ``handle_timeout(ms)`` as ``lcm.LCM`` has them, so a
   subscriber written for either runs on both;
+- ``Publisher(url)``: sends on it, ``publish(channel, message_or_bytes)`` as ``lcm.LCM`` has it
+  (a large message, a long trajectory, in fragments as liblcm sends them); with
+  ``pose_input(...)`` and ``trajectory(...)``, the two messages trajroid takes in;
 - ``read_log(path)``: the events of an ``lcm-logger`` log;
 - ``decode(data)``: the message as its trajroi type, found by its fingerprint.
 
 Run as a program, ``python3 -m trajroi_lcm LOG`` prints each channel's message count and type.
+
+A robot's localization feeding trajroid (pose.source: lcm), and a planner replacing its
+trajectory::
+
+    import time, trajroi_lcm
+    out = trajroi_lcm.Publisher("udpm://239.255.76.67:7667?ttl=0")
+    out.publish("TRAJROI_POSE_INPUT", trajroi_lcm.pose_input(
+        t_ns=time.time_ns(), position=(12.5, -3.2, 0.0), orientation=(1.0, 0.0, 0.0, 0.0)))
+    out.publish("TRAJROI_TRAJECTORY", trajroi_lcm.trajectory(7, [(0.0, 0.0), (40.0, 0.0)]))
 """
 
+import itertools
 import socket
 import struct
 import sys
@@ -22,6 +35,8 @@ import trajroi
 _SHORT_MAGIC = 0x4C433032  # "LC02": a whole message in one datagram
 _LONG_MAGIC = 0x4C433033  # "LC03": one fragment of a larger message
 _LOG_SYNC = 0xEDA1DA01
+_SHORT_MESSAGE_MAX = 65499  # channel + NUL + payload in one LC02 datagram (liblcm's limit)
+_FRAGMENT_MAX = 65487  # channel (first fragment) + payload per LC03 datagram
 
 _TYPES = {}
 for _name in dir(trajroi):
@@ -59,18 +74,14 @@ class Subscriber:
     """An LCM udpm:// receiver: ``subscribe``, then ``handle`` or ``handle_timeout``."""
 
     def __init__(self, url="udpm://239.255.76.67:7667", recv_buf_size=None):
-        parsed = urllib.parse.urlparse(url)
-        if parsed.scheme != "udpm":
-            raise ValueError("only udpm:// URLs: %s" % url)
-        group, _, port = (parsed.netloc or "239.255.76.67:7667").partition(":")
-        options = urllib.parse.parse_qs(parsed.query)
+        group, port, options = _udpm_address(url)
         if recv_buf_size is None and "recv_buf_size" in options:
             recv_buf_size = int(options["recv_buf_size"][0])
         self._socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
         self._socket.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         if recv_buf_size:
             self._take_receive_buffer(recv_buf_size)
-        self._socket.bind(("", int(port or 7667)))
+        self._socket.bind(("", port))
         membership = struct.pack("4s4s", socket.inet_aton(group), socket.inet_aton("0.0.0.0"))
         self._socket.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, membership)
         self._handlers = {}
@@ -152,6 +163,78 @@ class Subscriber:
         for handler in self._handlers.get(channel, []):
             handler(channel, data)
         return 1
+
+
+def _udpm_address(url):
+    parsed = urllib.parse.urlparse(url)
+    if parsed.scheme != "udpm":
+        raise ValueError("only udpm:// URLs: %s" % url)
+    group, _, port = (parsed.netloc or "239.255.76.67:7667").partition(":")
+    return group, int(port or 7667), urllib.parse.parse_qs(parsed.query)
+
+
+class Publisher:
+    """An LCM udpm:// sender: ``publish(channel, message)`` as ``lcm.LCM.publish``.
+
+    The URL's ``ttl`` is honoured (default 0: this host only, as trajroid's default URL)."""
+
+    def __init__(self, url="udpm://239.255.76.67:7667?ttl=0"):
+        group, port, options = _udpm_address(url)
+        self._destination = (group, port)
+        self._socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+        ttl = int(options.get("ttl", ["0"])[0])
+        self._socket.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, ttl)
+        self._socket.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
+        self._sequence = itertools.count()
+
+    def close(self):
+        self._socket.close()
+
+    def publish(self, channel, message):
+        """Sends ``message`` (a trajroi type, or its encoded bytes) on ``channel``."""
+        data = message if isinstance(message, (bytes, bytearray)) else message.encode()
+        name = channel.encode() + b"\0"
+        if not 1 < len(name) <= 64:
+            raise ValueError("LCM channel names are 1 to 63 bytes: %r" % channel)
+        sequence = next(self._sequence) & 0xFFFFFFFF
+        if len(name) + len(data) <= _SHORT_MESSAGE_MAX:
+            self._socket.sendto(struct.pack(">II", _SHORT_MAGIC, sequence) + name + data, self._destination)
+            return
+        count = (len(name) + len(data) + _FRAGMENT_MAX - 1) // _FRAGMENT_MAX
+        offset = 0
+        for number in range(count):
+            head = name if number == 0 else b""
+            piece = data[offset:offset + _FRAGMENT_MAX - len(head)]
+            header = struct.pack(">IIIIHH", _LONG_MAGIC, sequence, len(data), offset, number, count)
+            self._socket.sendto(header + head + piece, self._destination)
+            offset += len(piece)
+
+
+def pose_input(t_ns, position, orientation, lat_lon=False, monotonic=False, valid=True):
+    """A ``pose_input_t``: the robot's pose at ``t_ns`` (UTC ns since 1970, or the host's
+    CLOCK_MONOTONIC with ``monotonic``), ``position`` x east, y north, z up in m in trajroid's
+    global frame (or latitude deg, longitude deg, height m with ``lat_lon``), ``orientation``
+    global_from_robot as a unit quaternion (w, x, y, z); ``valid`` False when the localizer is lost."""
+    m = trajroi.pose_input_t()
+    m.t_ns = int(t_ns)
+    m.clock = trajroi.pose_input_t.STAMP_MONOTONIC if monotonic else trajroi.pose_input_t.STAMP_UTC
+    m.frame = trajroi.pose_input_t.LAT_LON if lat_lon else trajroi.pose_input_t.GLOBAL_XY
+    m.position = [float(v) for v in position]
+    m.orientation = [float(v) for v in orientation]
+    m.valid = bool(valid)
+    return m
+
+
+def trajectory(trajectory_id, waypoints, lat_lon=False):
+    """A ``trajectory_t`` with id ``trajectory_id`` (> 0) through ``waypoints``: (x, y) in m in the
+    global frame, or (latitude, longitude) in degrees with ``lat_lon``."""
+    m = trajroi.trajectory_t()
+    m.id = int(trajectory_id)
+    m.coordinates = trajroi.trajectory_t.LAT_LON if lat_lon else trajroi.trajectory_t.GLOBAL_XY
+    m.num_waypoints = len(waypoints)
+    m.u = [float(w[0]) for w in waypoints]
+    m.v = [float(w[1]) for w in waypoints]
+    return m
 
 
 def _summary(path):
