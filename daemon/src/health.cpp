@@ -66,7 +66,9 @@ std::vector<HealthLine> HealthMonitor::update(const StatusSnapshot& s) {
   std::vector<HealthLine> out;
   const StatusSnapshot previous = history_.back();
   history_.push_back(s);
-  while (history_.size() > 2 && s.steady_ns - history_[1].steady_ns >= kWindow_ns)
+  // The oldest snapshot kept is the newest at least the window old (snapshots come once a
+  // second, give or take the loop's jitter).
+  while (history_.size() > 2 && s.steady_ns - history_[1].steady_ns >= kWindow_ns - kJitter_ns)
     history_.pop_front();
 
   lidar(s, out);

@@ -35,6 +35,7 @@ class HealthMonitor {
 
   // A fault is judged over at least this much history (the lines come within 5 s).
   static constexpr std::int64_t kWindow_ns = 3'000'000'000;
+  static constexpr std::int64_t kJitter_ns = 100'000'000;
 
  private:
   enum Fault : std::uint8_t {
@@ -72,7 +73,7 @@ class HealthMonitor {
     return static_cast<double>(s.steady_ns - history_.front().steady_ns) * 1e-9;
   }
   [[nodiscard]] bool judged(const StatusSnapshot& s) const noexcept {
-    return s.steady_ns - history_.front().steady_ns >= kWindow_ns;  // enough history for "nothing came"
+    return s.steady_ns - history_.front().steady_ns >= kWindow_ns - kJitter_ns;  // enough history for "nothing came"
   }
 
   const DaemonConfig& config_;

@@ -242,3 +242,30 @@ TEST(Config, TheReferencePageIsTheDaemonsOwnTable) {
 }
 
 }  // namespace
+
+namespace {
+
+// --check-config passes a configuration whose devices are not plugged in (a USB receiver may come
+// later) and says which are absent and that the daemon will wait for them.
+TEST(DaemonConfig, CheckConfigNamesAbsentDevicesAndSaysTheDaemonWillWait) {
+  const fs::path dir = fs::temp_directory_path() / ("trajroid_absent_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "trajectory.csv") << "0,0\n10,0\n";
+  std::string text = replaced(example(), "  device: \"\"                     # e.g. /dev/ttyACM0",
+                              "  device: /nonexistent/gnss  # e.g. /dev/ttyACM0");
+  text = replaced(text, "  device: \"\"                     # e.g. /dev/ttyUSB0", "  device: /dev/null  # e.g.");
+  std::ofstream(dir / "absent.yaml") << text;
+  const fs::path out = dir / "out.txt";
+  const int code = daemon_test::run_command(std::string(TRAJROID) + " --config " + (dir / "absent.yaml").string() +
+                                            " --check-config >" + out.string() + " 2>&1");
+  const std::string said = daemon_test::slurp(out);
+  EXPECT_EQ(code, 0) << said;
+  EXPECT_NE(said.find("gnss.device /nonexistent/gnss does not exist now: trajroid will start and wait for it"),
+            std::string::npos)
+      << said;
+  EXPECT_EQ(said.find("imu.device /dev/null does not exist"), std::string::npos) << said;
+  EXPECT_NE(said.find("configuration OK"), std::string::npos) << said;
+  fs::remove_all(dir);
+}
+
+}  // namespace
