@@ -27,18 +27,20 @@ std::string_view pose_source_name(PoseSource source) noexcept {
 
 std::string pose_reason(pose::PoseStatus status, double measured, double limit, const DaemonConfig& config) {
   std::string text = pose::describe(status, measured, limit, pose_words(config.pose_source));
-  const auto device = [](const DaemonConfig::Serial& s) { return s.device.empty() ? std::string("none") : s.device; };
+  const auto device = [](const char* key, const DaemonConfig::Serial& s) {
+    return s.device.empty() ? std::string(" (") + key + " is not set)" : std::string(" from ") + key + " " + s.device;
+  };
   switch (status) {
     case pose::PoseStatus::kNoGnss:
       if (uses_gnss(config.pose_source)) {
-        text += " from gnss.device " + device(config.gnss);
+        text += device("gnss.device", config.gnss);
       } else if (config.pose_source == PoseSource::kLcm) {
         text += " on " + config.lcm.pose_input + " (lcm.channels.pose_input)";
       }
       break;
     case pose::PoseStatus::kNoAttitude:
       if (config.pose_source == PoseSource::kGnssImu) {
-        text += " from imu.device " + device(config.imu);
+        text += device("imu.device", config.imu);
       } else if (config.pose_source == PoseSource::kGnss) {
         char more[240];
         std::snprintf(more, sizeof more,
@@ -47,6 +49,11 @@ std::string pose_reason(pose::PoseStatus status, double measured, double limit, 
                       config.gnss_heading.min_speed_mps);
         text += more;
       }
+      break;
+    case pose::PoseStatus::kBeforeFirstSample:
+      text +=
+          " (the sweep is older than the pose history kept: pose.buffer_samples, or the sensor's time "
+          "is behind the pose inputs')";
       break;
     default:
       break;

@@ -119,6 +119,34 @@ TEST(LiveMessages, GarbageOnTheLidarPortIsNamedWithSizesAndSendersAndNotBlamedOn
   rig.stop(daemon);
 }
 
+// The sensor's packets and other datagrams on the same port: said once a minute, with the counts.
+TEST(LiveMessages, OtherDatagramsAmidTheSensorsPacketsAreSummarisedOnceAMinute) {
+  const Rig rig("mixed", "fixed", 11);
+  const fs::path& corridor = corridor_run();
+  const auto start = std::chrono::steady_clock::now();
+  Child daemon(rig.daemon_args(), rig.daemon_log);
+  // The corridor's 29 s of VLP-16 data at 0.45 × real time: 64 s of packets.
+  Child lidar(TRAJROI_CLI, rig.pcap_feed(corridor / "lidar.pcap", "0.5", {"--rate", "0.45"}), rig.feed_log);
+  // The other sender starts once the sensor's sweeps are published (else it would be alone).
+  ASSERT_GE(seconds_until_logged(rig.daemon_log, "status: publishing", start, seconds(10)), 0.0) << rig.logs();
+  std::atomic<bool> stop{false};
+  std::thread sender([&] {
+    while (!stop) {
+      send_garbage(rig.data_port, 5);
+      std::this_thread::sleep_for(milliseconds(200));
+    }
+  });
+  const double at = seconds_until_logged(rig.daemon_log, "were not VLP-16 data packets, beside ", start, seconds(70));
+  stop = true;
+  sender.join();
+  EXPECT_GE(at, 55.0) << rig.logs();
+  EXPECT_LE(at, 66.0) << rig.logs();
+  const std::string log = slurp(rig.daemon_log);
+  EXPECT_NE(log.find("from 127.0.0.1:"), std::string::npos) << log;
+  EXPECT_EQ(log.find("none a VLP-16 data packet"), std::string::npos) << "the sensor's packets came too\n" << log;
+  rig.stop(daemon);
+}
+
 // ---- what a serial port carries --------------------------------------------------------------
 
 TEST(LiveMessages, NmeaOnTheReceiverPortIsNamedWithItsRemedy) {

@@ -64,7 +64,7 @@ TEST(LivePoseMessages, AParkedRobotOnGnssAloneIsToldTheSettingsThatGiveItAHeadin
   Child daemon(rig.daemon_args(), rig.daemon_log);
   const auto start = std::chrono::steady_clock::now();
   Child feeder(TRAJROI_CLI,
-               rig.pcap_feed(pcap, "2", {"--until", "5", "--ubx", ubx.string(), "--gnss-link", rig.gnss_link.string()}),
+               rig.pcap_feed(pcap, "2", {"--until", "6", "--ubx", ubx.string(), "--gnss-link", rig.gnss_link.string()}),
                rig.feed_log);
   EXPECT_LOGGED_WITHIN_5S(
       rig,
@@ -72,10 +72,16 @@ TEST(LivePoseMessages, AParkedRobotOnGnssAloneIsToldTheSettingsThatGiveItAHeadin
       "pose.gnss_heading.min_speed_mps (1.00 m/s) and no moving-base heading came; to start parked, "
       "set pose.gnss_heading.initial_heading_deg)",
       start);
+  // The state says it too, while the receiver is still there.
+  EXPECT_TRUE(listener.wait_for(
+      [&] {
+        return !listener.statuses.empty() &&
+               listener.statuses.back().state.find("no valid pose: no GNSS heading yet") != std::string::npos;
+      },
+      seconds(3)))
+      << last_status(listener).state;
+  EXPECT_EQ(last_status(listener).pose_source, "gnss");
   ASSERT_EQ(feeder.wait(seconds(30)), 0) << rig.logs();
-  const trajroi::status_t s = last_status(listener);
-  EXPECT_NE(s.state.find("no valid pose: no GNSS heading yet"), std::string::npos) << s.state;
-  EXPECT_EQ(s.pose_source, "gnss");
   rig.stop(daemon);
 }
 

@@ -118,7 +118,7 @@ reload)
   pid=$(show MainPID)
   printf 'x,y\n0,0\n5,5\n' >"$work/trajectory.csv"
   nsd systemctl reload trajroid.service
-  wait_for 5 journal_has "SIGHUP: trajectory reloaded from $work/trajectory.csv" || fail "no reload"
+  wait_for 5 journal_has "SIGHUP: trajectory 1 reloaded from $work/trajectory.csv" || fail "no reload (as trajectory 1)"
   printf 'x,y\n0,0\n' >"$work/trajectory.csv"
   nsd systemctl reload trajroid.service
   wait_for 5 journal_has "SIGHUP: trajectory not reloaded" || fail "a bad trajectory was not named"
@@ -237,7 +237,7 @@ YAML
   sleep 1
   printf 'lat,lon\n50.13470,14.42990\n50.13550,14.43000\n' >"$work/trajectory.csv"
   nsd systemctl reload trajroid.service
-  wait_for 3 journal_has "SIGHUP: trajectory reloaded" || fail "no reload"
+  wait_for 3 journal_has "SIGHUP: trajectory 1 reloaded from" || fail "no reload (as trajectory 1)"
   wait "$feed_pid" || fail "feed: $(tail -5 "$work/feed.log")"
   feed_pid=""
   sleep 1
@@ -253,6 +253,9 @@ YAML
   valid=$(awk '/^points_with_valid_pose/ {print $2}' <<<"$summary")
   read -r heading_min heading_max < <(awk '/^roi_heading_deg/ {print $2, $3}' <<<"$summary")
   [ "$valid" -ge 3 ] || fail "only $valid point clouds with a valid pose reached the subscriber outside"
+  # The reload is visible to subscribers: the clouds are filtered against trajectory 1.
+  last_id=$(awk '/^last_trajectory_id/ {print $2}' <<<"$summary")
+  [ "$last_id" = 1 ] || fail "the last status names trajectory $last_id, not the reloaded one (1)"
   # The trajectory at start runs due north (90°); the reloaded one at 85.4° (89 m north, 7.1 m east).
   awk -v lo="$heading_min" -v hi="$heading_max" 'BEGIN { exit !(lo > 84.9 && hi < 85.9) }' ||
     fail "the ROIs are not placed on the reloaded trajectory (headings $heading_min … $heading_max°, expected 85.4°)"

@@ -54,6 +54,8 @@ std::string describe(PoseStatus status, double measured, double limit, const Pos
       return say("GNSS fix type %.0f < minimum %.0f (pose.min_fix_type)", measured, limit);
     case PoseStatus::kNoGnssFixOk:
       return "GNSS fix not flagged gnssFixOK (pose.require_gnss_fix_ok)";
+    case PoseStatus::kNotRtkFixed:
+      return "GNSS carrier solution not fixed (pose.require_rtk_fixed)";
     case PoseStatus::kAccuracyTooLow:
       return say("GNSS horizontal accuracy %.2f m > limit %.2f m (pose.max_h_acc_m)", measured, limit);
     case PoseStatus::kGnssTooOld:
