@@ -22,6 +22,8 @@ packages=(
   systemd util-linux iproute2 python3
   # the man pages (from --help) and the .deb (cpack: dpkg-shlibdeps)
   help2man dpkg-dev
+  # independent readers of `trajroi export`'s files in the tests: PCL's tools, Open3D
+  pcl-tools python3-open3d
 )
 
 if [ "$(id -u)" -ne 0 ]; then

@@ -15,6 +15,7 @@ void add_watch_command(CLI::App& app);      // listens to trajroid over LCM
 void add_configure_command(CLI::App& app);  // trajroi configure gnss|imu
 void add_feed_command(CLI::App& app);       // plays a run folder into a live trajroid
 void add_machine_command(CLI::App& app);    // how steadily this machine gives a thread its CPU
+void add_export_command(CLI::App& app);     // kept points from an LCM log as PCD / PLY files
 // keyframes, sequential, accumulated under `eval`.
 void add_scenario_eval_commands(CLI::App& eval_cmd);
 
