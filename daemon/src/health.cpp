@@ -177,6 +177,11 @@ void HealthMonitor::update_state(const StatusSnapshot& s, const StatusSnapshot& 
   } else if (active_[kLidarForeignOnly]) {
     add(sprintf_text("LiDAR: datagrams on UDP port %u only from addresses other than sensor_address %s", l.data_port,
                      l.sensor_address.c_str()));
+  } else if (live_ && accepted_packets(s) == accepted_packets(history_.front()) &&
+             rejected(s, vlp16::PacketError::kUnsupportedProduct) >
+                 rejected(history_.front(), vlp16::PacketError::kUnsupportedProduct)) {
+    const std::string reason = s.model_reason.data();
+    add("LiDAR: packets rejected: " + (reason.empty() ? std::string("not a VLP-16") : reason));
   } else if (active_[kLidarSilent] || (live_ && accepted_packets(s) == 0)) {
     add(sprintf_text("waiting for LiDAR data on UDP port %u", l.data_port));
   }

@@ -116,6 +116,7 @@ TEST(Health, DatagramsOnlyFromAnotherSenderNameTheSensorAddress) {
 
 TEST(Health, AnUnsupportedModelIsNamedWithTheDriversReason) {
   const Said said = run(live_config(), 3, [](StatusSnapshot& s, int) {
+    s.lidar_packets += 1800;  // counted, and rejected
     s.counters[static_cast<std::size_t>(Counter::kLidarRejected) +
                static_cast<std::size_t>(trajroi::vlp16::PacketError::kUnsupportedProduct) - 1] += 1800;
     const std::string reason = "product id 0x21 (HDL-32E) is not supported";
@@ -124,6 +125,9 @@ TEST(Health, AnUnsupportedModelIsNamedWithTheDriversReason) {
   EXPECT_EQ(said.first("lidar: 1800 packets rejected in the last second: product id 0x21 (HDL-32E) is not supported"),
             1)
       << said.all();
+  // The state names the model, not "waiting for LiDAR data": its packets do come.
+  EXPECT_EQ(said.state.rfind("LiDAR: packets rejected: product id 0x21 (HDL-32E) is not supported", 0), 0U)
+      << said.state;
 }
 
 TEST(Health, BytesButNoFramesSayWrongBaudRateWithTheFigures) {
