@@ -112,9 +112,12 @@ void expect_same(const std::vector<std::vector<double>>& rows, const trajroi::po
   for (std::size_t i = 0; i < rows.size(); ++i) {
     ASSERT_EQ(rows[i].size(), 7U) << what;
     // PCL prints floats to 8 significant digits: within float rounding of the message's.
-    EXPECT_NEAR(rows[i][0], double{m.x[i]}, 1e-5 * (1.0 + std::abs(double{m.x[i]}))) << what << " point " << i;
-    EXPECT_NEAR(rows[i][1], double{m.y[i]}, 1e-5 * (1.0 + std::abs(double{m.y[i]}))) << what << " point " << i;
-    EXPECT_NEAR(rows[i][2], double{m.z[i]}, 1e-5 * (1.0 + std::abs(double{m.z[i]}))) << what << " point " << i;
+    EXPECT_NEAR(rows[i][0], static_cast<double>(m.x[i]), 1e-5 * (1.0 + std::abs(static_cast<double>(m.x[i]))))
+        << what << " point " << i;
+    EXPECT_NEAR(rows[i][1], static_cast<double>(m.y[i]), 1e-5 * (1.0 + std::abs(static_cast<double>(m.y[i]))))
+        << what << " point " << i;
+    EXPECT_NEAR(rows[i][2], static_cast<double>(m.z[i]), 1e-5 * (1.0 + std::abs(static_cast<double>(m.z[i]))))
+        << what << " point " << i;
     EXPECT_EQ(rows[i][3], static_cast<double>(m.intensity[i])) << what << " point " << i;
     EXPECT_EQ(rows[i][4], static_cast<double>(m.ring[i])) << what << " point " << i;
     EXPECT_NEAR(rows[i][5], static_cast<double>(m.time_offset_ns[i]) * 1e-9, 1e-7) << what << " point " << i;
