@@ -121,8 +121,8 @@ TEST(LiveMessages, GarbageOnTheLidarPortIsNamedWithSizesAndSendersAndNotBlamedOn
 
 // The sensor's packets and other datagrams on the same port: said once a minute, with the counts.
 TEST(LiveMessages, OtherDatagramsAmidTheSensorsPacketsAreSummarisedOnceAMinute) {
+  const fs::path& corridor = corridor_run();  // simulated before the clock starts
   const Rig rig("mixed", "fixed", 11);
-  const fs::path& corridor = corridor_run();
   const auto start = std::chrono::steady_clock::now();
   Child daemon(rig.daemon_args(), rig.daemon_log);
   // The corridor's 29 s of VLP-16 data at 0.45 × real time: 64 s of packets.
