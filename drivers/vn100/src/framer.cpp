@@ -35,18 +35,6 @@ std::size_t field_size(Group group, unsigned bit) noexcept {
   }
 }
 
-std::uint16_t crc16_ccitt(std::span<const std::uint8_t> bytes) noexcept {
-  std::uint16_t crc = 0;
-  for (const std::uint8_t b : bytes) {
-    crc = static_cast<std::uint16_t>((crc >> 8) | (crc << 8));
-    crc ^= b;
-    crc ^= static_cast<std::uint16_t>((crc & 0xFF) >> 4);
-    crc ^= static_cast<std::uint16_t>(crc << 12);
-    crc ^= static_cast<std::uint16_t>((crc & 0x00FF) << 5);
-  }
-  return crc;
-}
-
 std::optional<Layout> parse_layout(std::span<const std::uint8_t> frame) noexcept {
   if (frame.size() < 2 || frame[0] != kSync || frame[1] == 0) return std::nullopt;
   Layout layout;

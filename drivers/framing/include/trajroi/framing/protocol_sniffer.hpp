@@ -10,20 +10,9 @@
 #include <cstdint>
 #include <span>
 
-namespace trajroi::framing {
+#include "trajroi/framing/checksums.hpp"
 
-// RTCM 10403.x's CRC-24Q (polynomial 0x1864CFB, initial 0) over `bytes`.
-[[nodiscard]] constexpr std::uint32_t crc24q(std::span<const std::uint8_t> bytes) noexcept {
-  std::uint32_t crc = 0;
-  for (const std::uint8_t b : bytes) {
-    crc ^= static_cast<std::uint32_t>(b) << 16;
-    for (int i = 0; i < 8; ++i) {
-      crc <<= 1;
-      if ((crc & 0x1000000U) != 0) crc ^= 0x1864CFBU;
-    }
-  }
-  return crc & 0xFFFFFFU;
-}
+namespace trajroi::framing {
 
 struct SnifferCounters {
   std::uint64_t nmea_sentences = 0;         // checksum-correct NMEA 0183 sentences
@@ -51,18 +40,6 @@ class ProtocolSniffer {
     if (c >= 'a' && c <= 'f') return c - 'a' + 10;
     return -1;
   }
-  static std::uint16_t crc16_ccitt(std::span<const std::uint8_t> bytes) noexcept {
-    std::uint16_t crc = 0;
-    for (const std::uint8_t b : bytes) {
-      crc = static_cast<std::uint16_t>((crc >> 8) | (crc << 8));
-      crc ^= b;
-      crc ^= static_cast<std::uint16_t>((crc & 0xFF) >> 4);
-      crc ^= static_cast<std::uint16_t>(crc << 12);
-      crc ^= static_cast<std::uint16_t>((crc & 0xFF) << 5);
-    }
-    return crc;
-  }
-
   // A line from '$' to its line feed: "$" body "*" checksum ["\r"] "\n".
   void text(std::uint8_t b) noexcept {
     if (b == '$') {

@@ -17,6 +17,7 @@
 #include <span>
 #include <vector>
 
+#include "trajroi/framing/checksums.hpp"
 #include "trajroi/framing/stream_framer.hpp"
 
 namespace trajroi::vn100 {
@@ -30,7 +31,7 @@ enum class Group : std::uint8_t { kCommon = 0, kTime = 1, kImu = 2, kGps = 3, kA
 [[nodiscard]] std::size_t field_size(Group group, unsigned bit) noexcept;
 
 // Bytes from the group byte to the last CRC byte, CRC-16/CCITT with init 0.
-[[nodiscard]] std::uint16_t crc16_ccitt(std::span<const std::uint8_t> bytes) noexcept;
+using framing::crc16_ccitt;  // trajroi/framing/checksums.hpp
 
 // The layout a header describes.
 struct Layout {
