@@ -202,6 +202,21 @@ std::vector<ConfigKey> make_keys() {
                           &DaemonConfig::Lcm::trajectory));
   k.push_back(channel_key("lcm.channels.pose_input", "pose_input_t (input, pose.source lcm): the robot's localization",
                           &DaemonConfig::Lcm::pose_input));
+  k.push_back(channel_key("lcm.channels.raw_points",
+                          "points_t (outputs.raw_points): each sweep's decoded points before the ROI, decimated",
+                          &DaemonConfig::Lcm::raw_points));
+  k.push_back(channel_key("lcm.channels.active_trajectory",
+                          "trajectory_t: the active trajectory (global x/y, its id), as it changes and once a second",
+                          &DaemonConfig::Lcm::active_trajectory));
+  // ---- outputs
+  k.push_back(flag_key(
+      "outputs.raw_points",
+      "publish each sweep's decoded points before the ROI (global frame, decimated) on lcm.channels.raw_points, for "
+      "`trajroi view` to draw what the ROI removed",
+      [](auto& c) -> auto& { return c.outputs.raw_points; }));
+  k.push_back(count_key(
+      "outputs.raw_points_decimation", "outputs.raw_points keeps one point in this many (by its index in the sweep)", 1,
+      1000, [](auto& c) -> auto& { return c.outputs.raw_points_decimation; }));
   // ---- buffers, time, logging, realtime
   k.push_back(count_key(
       "buffers.lidar_packets", "ring of the LiDAR input (≈ 2.7 s of dual-return packets)", 16, std::size_t{1} << 20,

@@ -9,6 +9,10 @@ void MessageSender::make_resident() {
   daemon::encode_points(pipeline::Sweep{}, config_, points_, points_encoded_);
   points_encoded_.resize(points_encoded_.size() + 4096 + config_.buffers.max_points_per_sweep * kEncodedBytesPerPoint);
   points_encoded_.clear();
+  if (config_.outputs.raw_points) {
+    raw_encoded_.resize(points_encoded_.capacity());
+    raw_encoded_.clear();
+  }
 }
 
 void MessageSender::send_pose(const pipeline::Sweep& s) {
@@ -27,6 +31,16 @@ void MessageSender::encode_points(const pipeline::Sweep& s) {
 
 void MessageSender::send_points() {
   outlet_.publish(config_.lcm.points, points_encoded_);
+}
+
+void MessageSender::send_raw_points(const pipeline::Sweep& s) {
+  daemon::encode_points(s, s.raw, config_, points_, raw_encoded_);
+  outlet_.publish(config_.lcm.raw_points, raw_encoded_);
+}
+
+void MessageSender::send_trajectory(const pipeline::ActiveTrajectory& t) {
+  fill_trajectory(t, trajectory_);
+  send(config_.lcm.active_trajectory, trajectory_);
 }
 
 }  // namespace trajroi::daemon

@@ -27,6 +27,9 @@ class MessageSender {
   // The sweep's points encoded (the timing's encoding step), then sent.
   void encode_points(const pipeline::Sweep& s);
   void send_points();
+  // outputs.raw_points: the sweep's decoded points before the ROI (Sweep::raw).
+  void send_raw_points(const pipeline::Sweep& s);
+  void send_trajectory(const pipeline::ActiveTrajectory& t);
 
   template <typename Message>
   void send(const std::string& channel, const Message& m) {
@@ -41,9 +44,11 @@ class MessageSender {
   const DaemonConfig& config_;
   std::vector<std::uint8_t> encoded_;
   std::vector<std::uint8_t> points_encoded_;
+  std::vector<std::uint8_t> raw_encoded_;
   trajroi::points_t points_;
   trajroi::pose_t pose_;
   trajroi::roi_t roi_;
+  trajroi::trajectory_t trajectory_;
 };
 
 }  // namespace trajroi::daemon

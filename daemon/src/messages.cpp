@@ -62,7 +62,7 @@ std::uint8_t* store_be32_array(std::uint8_t* out, const std::vector<T, Allocator
 }
 
 // Every field of points_t but the points.
-void fill_points_head(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::points_t& out) {
+void fill_points_head(const pipeline::SweepHeader& sweep, const DaemonConfig& config, trajroi::points_t& out) {
   out.sweep_index = static_cast<std::int64_t>(sweep.index);
   out.sweep_start_ns = sweep.start_ns;
   out.sweep_end_ns = sweep.end_ns;
@@ -81,7 +81,7 @@ void fill_points_head(const pipeline::Sweep& sweep, const DaemonConfig& config, 
 
 }  // namespace
 
-void fill_pose(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::pose_t& out) {
+void fill_pose(const pipeline::SweepHeader& sweep, const DaemonConfig& config, trajroi::pose_t& out) {
   out.t_ns = sweep.pose_t_ns;
   out.sweep_index = static_cast<std::int64_t>(sweep.index);
   out.valid = sweep.pose_status == pose::PoseStatus::kValid;
@@ -115,6 +115,11 @@ void fill_points(const pipeline::Sweep& sweep, const DaemonConfig& config, trajr
 
 void encode_points(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::points_t& head,
                    std::vector<std::uint8_t>& out) {
+  encode_points(sweep, sweep, config, head, out);
+}
+
+void encode_points(const pipeline::SweepHeader& sweep, const pipeline::PointColumns& points, const DaemonConfig& config,
+                   trajroi::points_t& head, std::vector<std::uint8_t>& out) {
   fill_points_head(sweep, config, head);
   head.num_points = 0;  // the arrays empty: num_points is the head's last field, patched below
   head.x.clear();
@@ -125,19 +130,32 @@ void encode_points(const pipeline::Sweep& sweep, const DaemonConfig& config, tra
   head.return_type.clear();
   head.time_offset_ns.clear();
   const auto head_size = static_cast<std::size_t>(head.getEncodedSize());
-  const std::size_t n = sweep.size();
+  const std::size_t n = points.size();
   out.resize(head_size + n * kEncodedBytesPerPoint);
   std::uint8_t* p = out.data();
   (void)head.encode(p, 0, static_cast<int>(head_size));
   store_be32(p + head_size - 4, static_cast<std::uint32_t>(n));
   p += head_size;
-  p = store_be32_array(p, sweep.x);
-  p = store_be32_array(p, sweep.y);
-  p = store_be32_array(p, sweep.z);
-  p = std::copy(sweep.intensity.begin(), sweep.intensity.end(), p);
-  p = std::copy(sweep.ring.begin(), sweep.ring.end(), p);
-  p = std::copy(sweep.return_type.begin(), sweep.return_type.end(), p);
-  (void)store_be32_array(p, sweep.time_offset_ns);
+  p = store_be32_array(p, points.x);
+  p = store_be32_array(p, points.y);
+  p = store_be32_array(p, points.z);
+  p = std::copy(points.intensity.begin(), points.intensity.end(), p);
+  p = std::copy(points.ring.begin(), points.ring.end(), p);
+  p = std::copy(points.return_type.begin(), points.return_type.end(), p);
+  (void)store_be32_array(p, points.time_offset_ns);
+}
+
+void fill_trajectory(const pipeline::ActiveTrajectory& trajectory, trajroi::trajectory_t& out) {
+  const std::vector<Eigen::Vector2d>& w = trajectory.trajectory.waypoints();
+  out.id = trajectory.id;
+  out.coordinates = trajroi::trajectory_t::GLOBAL_XY;
+  out.num_waypoints = static_cast<std::int32_t>(w.size());
+  out.u.resize(w.size());
+  out.v.resize(w.size());
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    out.u[i] = w[i].x();
+    out.v[i] = w[i].y();
+  }
 }
 
 void fill_roi(const pipeline::Sweep& sweep, trajroi::roi_t& out) {

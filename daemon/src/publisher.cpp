@@ -12,14 +12,15 @@
 
 namespace trajroi::daemon {
 
-Publisher::Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, bool replay)
+Publisher::Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, bool replay,
+                     const pipeline::ActiveTrajectory& trajectory)
     : pipeline_(pipeline),
       outlet_(outlet),
       replay_(replay),
       config_(pipeline.config),
       start_steady_ns_(host::monotonic_ns()),
       sender_(outlet, pipeline.config),
-      trajectories_(pipeline, reloader),
+      trajectories_(pipeline, reloader, trajectory),
       latency_(pipeline.config.logging.warning_interval_s, !pipeline.exact),
       health_(pipeline.config, !replay, start_steady_ns_),
       sweep_warnings_(pipeline.config.logging.warning_interval_s) {
@@ -41,6 +42,8 @@ Publisher::Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, boo
 
 void Publisher::publish_sweep(const pipeline::Sweep& s) {
   const std::int64_t dequeued_ns = host::monotonic_ns();
+  // A sweep filtered against another trajectory: it is the active one now (the viewers' line).
+  if (trajectories_.activate(s.trajectory_id)) sender_.send_trajectory(trajectories_.active());
   sender_.send_pose(s);
   if (s.filtered) {
     sender_.send_roi(s);
@@ -61,6 +64,8 @@ void Publisher::publish_sweep(const pipeline::Sweep& s) {
                                .sending_ms = ms(encoded_ns, sent_ns)};
       latency_.add(timing, sent_ns);
     }
+    // After the kept points and outside their latency: for viewers only.
+    if (config_.outputs.raw_points) sender_.send_raw_points(s);
   } else {
     // Each reason said as it first appears, its repeats summarised (log::ReasonLimiter).
     sweep_warnings_.warn(static_cast<std::uint32_t>(s.pose_status),
@@ -117,6 +122,8 @@ void Publisher::publish_status(const StatusSnapshot& s) {
   add("sweeps.late", latency_.late_sweeps());
   m.num_counters = static_cast<std::int32_t>(m.counter_names.size());
   sender_.send(config_.lcm.status, m);
+  // Once a second too, for a viewer that starts later.
+  sender_.send_trajectory(trajectories_.active());
 
   const double kept_pct =
       m.points_in > 0 ? 100.0 * static_cast<double>(m.points_kept) / static_cast<double>(m.points_in) : 0.0;

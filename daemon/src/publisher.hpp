@@ -24,7 +24,9 @@ namespace trajroi::daemon {
 class Publisher {
  public:
   // `replay`: said in the status message. `reloader` may be null (no SIGHUP reloads).
-  Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, bool replay);
+  // `trajectory`: the one active at start (published on lcm.channels.active_trajectory).
+  Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, bool replay,
+            const pipeline::ActiveTrajectory& trajectory);
   void run();
 
   // After run(): the last status and the whole run's latency, for the summary.

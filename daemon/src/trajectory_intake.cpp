@@ -2,13 +2,15 @@
 
 namespace trajroi::daemon {
 
-TrajectoryIntake::TrajectoryIntake(Pipeline& pipeline, Reloader* reloader)
+TrajectoryIntake::TrajectoryIntake(Pipeline& pipeline, Reloader* reloader, const pipeline::ActiveTrajectory& initial)
     : pipeline_(pipeline),
       reloader_(reloader),
+      known_{initial},
       frame_(pose::GlobalFrame::local_cartesian(pipeline.config.origin)),
       warn_limit_(pipeline.config.logging.warning_interval_s) {}
 
 void TrajectoryIntake::offer(std::unique_ptr<pipeline::ActiveTrajectory> trajectory) {
+  known_.push_back(*trajectory);
   const bool pushed = pipeline_.trajectories_in.try_push(
       [&trajectory](TrajectoryItem& slot) { slot.trajectory = std::move(trajectory); });
   if (pushed) pipeline_.process_wake.notify();
@@ -33,6 +35,16 @@ void TrajectoryIntake::on_message(std::span<const std::uint8_t> bytes, const std
             check.trajectory->id, channel, check.trajectory->trajectory.waypoints().size(),
             check.trajectory->trajectory.length_m(), renumbered);
   offer(std::move(check.trajectory));
+}
+
+bool TrajectoryIntake::activate(std::int32_t id) {
+  if (known_.front().id == id) return false;
+  std::size_t i = 1;
+  while (i < known_.size() && known_[i].id != id)
+    ++i;
+  if (i == known_.size()) return false;
+  known_.erase(known_.begin(), known_.begin() + static_cast<std::ptrdiff_t>(i));
+  return true;
 }
 
 std::int32_t TrajectoryIntake::next_id(std::int32_t wanted) {

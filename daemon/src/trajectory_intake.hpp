@@ -8,6 +8,7 @@
 // points_t and roi_t tell which trajectory each sweep was filtered against.
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <span>
@@ -23,11 +24,17 @@ namespace trajroi::daemon {
 
 class TrajectoryIntake {
  public:
-  // `reloader` may be null (no SIGHUP reloads).
-  TrajectoryIntake(Pipeline& pipeline, Reloader* reloader);
+  // `reloader` may be null (no SIGHUP reloads). `initial`: the trajectory active at start.
+  TrajectoryIntake(Pipeline& pipeline, Reloader* reloader, const pipeline::ActiveTrajectory& initial);
 
   void on_message(std::span<const std::uint8_t> bytes, const std::string& channel);
   void take_reloads();
+  // The active trajectory as far as the sweeps tell: the one active at start, then each the
+  // processor took up (activate).
+  [[nodiscard]] const pipeline::ActiveTrajectory& active() const noexcept { return known_.front(); }
+  // A sweep was filtered against trajectory `id`: it becomes active() (the earlier ones are
+  // forgotten). False when it already was, or is not known.
+  bool activate(std::int32_t id);
   // Its counters, by name, for the status message.
   void add_counters(const std::function<void(std::string, std::uint64_t)>& add) const;
 
@@ -38,6 +45,9 @@ class TrajectoryIntake {
 
   Pipeline& pipeline_;
   Reloader* reloader_;
+  // Copies of the active trajectory (front) and of those offered since, by id ascending: the
+  // processor owns the ones it filters with.
+  std::deque<pipeline::ActiveTrajectory> known_;
   pose::GlobalFrame frame_;
   std::array<std::uint64_t, kTrajectoryRejectCount> rejects_{};
   std::uint64_t accepted_ = 0, reloads_ = 0, reload_errors_ = 0;

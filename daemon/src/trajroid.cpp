@@ -154,7 +154,7 @@ int run_pipeline(Pipeline& pipeline, pipeline::SweepProcessor& processor, Outlet
   const int sfd = signals ? block_signals() : -1;
   pipeline.lidar_decoder = &processor.packet_decoder();  // the input threads decode ahead with it
   Reloader reloader(TrajectorySource::from(pipeline.config), pipeline.publish_wake);
-  Publisher publisher(pipeline, outlet, &reloader, options.replay.has_value());
+  Publisher publisher(pipeline, outlet, &reloader, options.replay.has_value(), processor.active_trajectory());
   ProcessingOptions processing;
   processing.stall_after_s = options.stall_processing_after_s;
   processing.live = !options.replay.has_value();

@@ -30,19 +30,7 @@ Eigen::Isometry3d PublishedPose::isometry() const {
   return roi::pose_from_position_quaternion(position_m, orientation);
 }
 
-void Sweep::take(Sweep& other) {
-  static_cast<SweepHeader&>(*this) = other;
-  x.swap(other.x);
-  y.swap(other.y);
-  z.swap(other.z);
-  intensity.swap(other.intensity);
-  ring.swap(other.ring);
-  return_type.swap(other.return_type);
-  time_offset_ns.swap(other.time_offset_ns);
-  point_index = other.point_index;  // kept for evaluations only: unreserved in the ring's slots
-}
-
-void Sweep::reserve(std::size_t points, std::size_t centre_count) {
+void PointColumns::reserve(std::size_t points) {
   x.reserve(points);
   y.reserve(points);
   z.reserve(points);
@@ -50,11 +38,20 @@ void Sweep::reserve(std::size_t points, std::size_t centre_count) {
   ring.reserve(points);
   return_type.reserve(points);
   time_offset_ns.reserve(points);
-  centres.reserve(centre_count);
 }
 
-void Sweep::make_resident() {
-  clear_points();
+void PointColumns::swap(PointColumns& other) noexcept {
+  x.swap(other.x);
+  y.swap(other.y);
+  z.swap(other.z);
+  intensity.swap(other.intensity);
+  ring.swap(other.ring);
+  return_type.swap(other.return_type);
+  time_offset_ns.swap(other.time_offset_ns);
+}
+
+void PointColumns::make_resident() {
+  clear();
   touch_capacity(x);
   touch_capacity(y);
   touch_capacity(z);
@@ -64,7 +61,7 @@ void Sweep::make_resident() {
   touch_capacity(time_offset_ns);
 }
 
-void Sweep::clear_points() noexcept {
+void PointColumns::clear() noexcept {
   x.clear();
   y.clear();
   z.clear();
@@ -72,6 +69,30 @@ void Sweep::clear_points() noexcept {
   ring.clear();
   return_type.clear();
   time_offset_ns.clear();
+}
+
+void Sweep::take(Sweep& other) {
+  static_cast<SweepHeader&>(*this) = other;
+  PointColumns::swap(other);
+  raw.swap(other.raw);
+  point_index = other.point_index;  // kept for evaluations only: unreserved in the ring's slots
+}
+
+void Sweep::reserve(std::size_t points, std::size_t centre_count, std::size_t raw_points) {
+  PointColumns::reserve(points);
+  raw.reserve(raw_points);
+  centres.reserve(centre_count);
+}
+
+void Sweep::make_resident() {
+  clear_points();
+  PointColumns::make_resident();
+  raw.make_resident();
+}
+
+void Sweep::clear_points() noexcept {
+  PointColumns::clear();
+  raw.clear();
   point_index.clear();
 }
 

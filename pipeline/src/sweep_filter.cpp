@@ -66,6 +66,7 @@ pose::PoseStatus SweepProcessor::filter_batch(const vlp16::Frame& frame, std::si
   }
   const std::span<const roi::PointXYZI> placed(scratch_.data(), end - first);
   sink.on_placed(frame, first, placed);
+  if (config_.outputs.raw_points) keep_raw(frame, first, end);
   (void)chain_.filter(placed, kept_);
   Sweep& s = sweep_;
   const std::size_t room =
@@ -108,6 +109,27 @@ pose::PoseStatus SweepProcessor::filter_batch(const vlp16::Frame& frame, std::si
       index[k] = static_cast<std::uint32_t>(first + kept[k]);
   }
   return pose::PoseStatus::kValid;
+}
+
+std::size_t raw_points_capacity(const DaemonConfig& config) noexcept {
+  return config.outputs.raw_points ? config.buffers.max_points_per_sweep / config.outputs.raw_points_decimation : 0;
+}
+
+void SweepProcessor::keep_raw(const vlp16::Frame& frame, std::size_t first, std::size_t end) {
+  const std::size_t every = config_.outputs.raw_points_decimation;
+  PointColumns& raw = sweep_.raw;
+  const std::size_t capacity = raw.x.capacity();
+  for (std::size_t i = (first + every - 1) / every * every; i < end && raw.size() < capacity; i += every) {
+    const roi::PointXYZI& g = scratch_[i - first];
+    const vlp16::Point& p = frame.points[i];
+    raw.x.push_back(g.x);
+    raw.y.push_back(g.y);
+    raw.z.push_back(g.z);
+    raw.intensity.push_back(p.intensity);
+    raw.ring.push_back(p.ring);
+    raw.return_type.push_back(static_cast<std::uint8_t>(p.return_type));
+    raw.time_offset_ns.push_back(static_cast<std::int32_t>(p.time_offset_ns));
+  }
 }
 
 void SweepProcessor::end_sweep(const vlp16::Frame& frame, SweepSink& sink) {

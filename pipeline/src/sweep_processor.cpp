@@ -89,7 +89,7 @@ SweepProcessor::SweepProcessor(const DaemonConfig& config, std::unique_ptr<Activ
   const DaemonConfig::Roi& r = config_.roi;
   const double longest = r.look_ahead_m + r.max_speed_mps * r.look_ahead_per_mps_s;
   const auto centres = static_cast<std::size_t>(longest / (r.spacing_ratio * size_along(r))) + 2;
-  sweep_.reserve(config_.buffers.max_points_per_sweep, centres);
+  sweep_.reserve(config_.buffers.max_points_per_sweep, centres, raw_points_capacity(config_));
   chain_.reserve(centres);
   scratch_.resize(kScratchPoints);  // used as [0, batch): never resized (value-initialising) after
   kept_.reserve(kScratchPoints);

@@ -127,7 +127,15 @@ struct DaemonConfig {
     std::string status = "TRAJROI_STATUS";
     std::string trajectory = "TRAJROI_TRAJECTORY";
     std::string pose_input = "TRAJROI_POSE_INPUT";  // pose.source lcm
+    std::string raw_points = "TRAJROI_RAW_POINTS";  // outputs.raw_points
+    std::string active_trajectory = "TRAJROI_ACTIVE_TRAJECTORY";
   } lcm;
+
+  // Optional outputs, for viewers.
+  struct Outputs {
+    bool raw_points = false;                // every decoded point before the ROI, decimated
+    std::size_t raw_points_decimation = 4;  // one point in this many (by its index in the sweep)
+  } outputs;
 
   struct Buffers {
     std::size_t lidar_packets = 4096;  // ≈ 2.7 s of dual-return packets

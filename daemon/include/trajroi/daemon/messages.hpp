@@ -21,7 +21,7 @@
 namespace trajroi::daemon {
 
 // The configuration gives the pose mode and the pose source's words and fields.
-void fill_pose(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::pose_t& out);
+void fill_pose(const pipeline::SweepHeader& sweep, const DaemonConfig& config, trajroi::pose_t& out);
 void fill_points(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::points_t& out);
 // The sweep's points_t encoded (LCM's fingerprint and big-endian fields, the bytes
 // points_t::encode writes for fill_points' message) into `out`, resized to the size. The
@@ -29,6 +29,12 @@ void fill_points(const pipeline::Sweep& sweep, const DaemonConfig& config, trajr
 // them an element at a time. `head` is scratch for the fields before the arrays.
 void encode_points(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::points_t& head,
                    std::vector<std::uint8_t>& out);
+// The same with other columns under the sweep's head: the decoded points before the ROI
+// (outputs.raw_points, Sweep::raw).
+void encode_points(const pipeline::SweepHeader& sweep, const pipeline::PointColumns& points, const DaemonConfig& config,
+                   trajroi::points_t& head, std::vector<std::uint8_t>& out);
+// The active trajectory as published on lcm.channels.active_trajectory: its id, GLOBAL_XY.
+void fill_trajectory(const pipeline::ActiveTrajectory& trajectory, trajroi::trajectory_t& out);
 // The bytes a point takes in that encoding: x, y, z, time offset and one each of intensity,
 // ring and return type.
 inline constexpr std::size_t kEncodedBytesPerPoint = 4 * sizeof(std::uint32_t) + 3;

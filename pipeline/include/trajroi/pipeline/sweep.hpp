@@ -86,30 +86,46 @@ struct SweepHeader {
   std::int64_t handed_over_ns = 0;
 };
 
-struct Sweep : SweepHeader {
+// Points in the global frame as a structure of arrays (the columns of points_t).
+struct PointColumns {
   // Grown by resize() and then written: its new elements are left unwritten, not zeroed.
   template <typename T>
   using Array = std::vector<T, roi::DefaultInitAllocator<T>>;
-  // Kept points, global frame, structure of arrays.
   Array<float> x, y, z;
   Array<std::uint8_t> intensity, ring, return_type;
   Array<std::int32_t> time_offset_ns;
-  // With SweepProcessor::keep_point_indices(): each kept point's index among the decoded
-  // sweep's points (vlp16::Frame::points), for scoring against per-point truth.
-  Array<std::uint32_t> point_index;
 
-  // Becomes `other`: its header copied, its kept points taken by exchanging arrays, so that
+  void reserve(std::size_t points);
+  // Exchanges the arrays (their capacity goes with them: nothing allocated, nothing copied).
+  void swap(PointColumns& other) noexcept;
+  // Writes a page of each array's capacity at a time, so that the reserved memory is resident.
+  void make_resident();
+  void clear() noexcept;
+  [[nodiscard]] std::size_t size() const noexcept { return x.size(); }
+};
+
+struct Sweep : SweepHeader, PointColumns {
+  // The columns are the kept points. With SweepProcessor::keep_point_indices(): each kept
+  // point's index among the decoded sweep's points (vlp16::Frame::points), for scoring against
+  // per-point truth.
+  Array<std::uint32_t> point_index;
+  // With outputs.raw_points: every decoded point of the sweep placed in the global frame,
+  // before the ROI, one in outputs.raw_points_decimation (by its index in the sweep); empty
+  // otherwise, and for a sweep without a valid pose.
+  PointColumns raw;
+
+  // Becomes `other`: its header copied, its points taken by exchanging arrays, so that
   // `other` is left with this sweep's arrays (their capacity: nothing is allocated, nothing
   // copied, when both were reserved alike) and its points are to be cleared. The point
   // indices are copied.
   void take(Sweep& other);
-  void reserve(std::size_t points, std::size_t centres);
+  // `raw_points`: room for the decimated decoded points (0: none).
+  void reserve(std::size_t points, std::size_t centres, std::size_t raw_points = 0);
   // Empties the sweep and writes a page of its arrays' capacity at a time, so that the reserved
   // memory is resident: a sweep larger than any before it then takes no page fault, and a
   // flood or a busier scene does not grow the resident memory.
   void make_resident();
   void clear_points() noexcept;
-  [[nodiscard]] std::size_t size() const noexcept { return x.size(); }
 };
 
 class SweepSink {

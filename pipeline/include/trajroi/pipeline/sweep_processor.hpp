@@ -57,6 +57,10 @@ struct ProcessorCounters {
 [[nodiscard]] vlp16::Calibration load_calibration(const DaemonConfig& config);
 [[nodiscard]] vlp16::StreamOptions stream_options(const DaemonConfig& config);
 
+// The decoded points a sweep holds for outputs.raw_points: buffers.max_points_per_sweep /
+// outputs.raw_points_decimation (0 when off); more are left out.
+[[nodiscard]] std::size_t raw_points_capacity(const DaemonConfig& config) noexcept;
+
 // How the configuration sets up the pose input (IMU mounting and declination, the delays).
 [[nodiscard]] pose_input::PoseInputConfig pose_input_config(const DaemonConfig& config);
 
@@ -102,6 +106,8 @@ class SweepProcessor {
   // A trajectory no longer used, for the caller to free outside the real-time path.
   [[nodiscard]] std::unique_ptr<ActiveTrajectory> take_retired() noexcept;
   [[nodiscard]] std::int32_t active_trajectory_id() const noexcept { return active_->id; }
+  // The trajectory filtered with now (not while another thread runs process()).
+  [[nodiscard]] const ActiveTrajectory& active_trajectory() const noexcept { return *active_; }
 
   [[nodiscard]] const ProcessorCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const vlp16::StreamCounters& lidar_counters() const noexcept { return decoder_.counters(); }
@@ -133,6 +139,9 @@ class SweepProcessor {
   // sweep's), filters them in one scan and appends the kept ones. Answers kValid, or the
   // status of a firing whose pose was not valid (the sweep is then withheld).
   pose::PoseStatus filter_batch(const vlp16::Frame& frame, std::size_t first, std::size_t end, SweepSink& sink);
+  // outputs.raw_points: one in outputs.raw_points_decimation of the batch's placed points
+  // (scratch_), by their index in the frame, appended to the sweep's raw columns.
+  void keep_raw(const vlp16::Frame& frame, std::size_t first, std::size_t end);
 
   DaemonConfig config_;
   vlp16::StreamDecoder decoder_;
