@@ -24,6 +24,8 @@ packages=(
   help2man dpkg-dev
   # independent readers of `trajroi export`'s files in the tests: PCL's tools, Open3D
   pcl-tools python3-open3d
+  # trajroi view: three.js for its page; the browser tests' headless chromium and its driver
+  libjs-three chromium chromium-driver
 )
 
 if [ "$(id -u)" -ne 0 ]; then

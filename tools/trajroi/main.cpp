@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   trajroi::cli::add_configure_command(app);
   trajroi::cli::add_machine_command(app);
   trajroi::cli::add_export_command(app);
+  trajroi::cli::add_view_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

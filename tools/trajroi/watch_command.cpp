@@ -191,7 +191,7 @@ class ScoringThread {
 
 class Watcher {
  public:
-  explicit Watcher(const WatchOptions& o) : o_(o), lcm_(without_receive_buffer(o.url)) {
+  explicit Watcher(const WatchOptions& o) : o_(o), lcm_(transport::without_receive_buffer(o.url)) {
     if (!lcm_.good()) throw std::runtime_error("LCM: cannot open '" + o.url + "'");
     if (!o.run_dir.empty()) {
       scorer_ = std::make_unique<TruthScorer>(o.run_dir);
@@ -256,18 +256,6 @@ class Watcher {
   }
 
  private:
-  // liblcm sets the URL's recv_buf_size itself with SO_RCVBUF only, which the kernel caps at
-  // net.core.rmem_max without a word that counts: the watch asks for it, past the cap where it
-  // may, and says in one line when it was capped.
-  static std::string without_receive_buffer(const std::string& url) {
-    const std::size_t at = url.find("recv_buf_size=");
-    if (at == std::string::npos) return url;
-    std::size_t end = url.find('&', at);
-    std::string out = url.substr(0, at) + (end == std::string::npos ? "" : url.substr(end + 1));
-    while (!out.empty() && (out.back() == '&' || out.back() == '?'))
-      out.pop_back();
-    return out;
-  }
   void take_receive_buffer() {
     int bytes = 0;
     std::uint16_t port = 0;

@@ -80,4 +80,14 @@ std::string describe_capped(const std::string& who, const ReceiveBuffer& buffer)
          "/usr/lib/sysctl.d/60-trajroi-lcm.conf (systemd/60-trajroi-lcm.conf in the source tree)";
 }
 
+std::string without_receive_buffer(const std::string& url) {
+  const std::size_t at = url.find("recv_buf_size=");
+  if (at == std::string::npos) return url;
+  const std::size_t end = url.find('&', at);
+  std::string out = url.substr(0, at) + (end == std::string::npos ? "" : url.substr(end + 1));
+  while (!out.empty() && (out.back() == '&' || out.back() == '?'))
+    out.pop_back();
+  return out;
+}
+
 }  // namespace trajroi::transport

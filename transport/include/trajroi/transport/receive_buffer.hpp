@@ -33,6 +33,11 @@ ReceiveBuffer set_udp_receive_buffers(std::uint16_t port, int bytes);
 // none). False for a URL that is not udpm://.
 bool udpm_receive_options(const std::string& url, int& recv_buf_size, std::uint16_t& port);
 
+// The URL without its recv_buf_size= option. liblcm sets that buffer itself with SO_RCVBUF
+// only, which the kernel caps at net.core.rmem_max without a word: a subscriber opens the URL
+// without it and asks with set_udp_receive_buffers (past the cap where it may).
+[[nodiscard]] std::string without_receive_buffer(const std::string& url);
+
 // One line for a capped buffer, naming what to do about it ("" when it was not capped):
 // "<who>: the kernel capped the LCM receive buffer at 208 KiB of the 8192 KiB asked for
 //  (net.core.rmem_max); clouds may be lost. Run as root, or apply the sysctl drop-in …".
