@@ -26,6 +26,8 @@ packages=(
   pcl-tools python3-open3d
   # trajroi view: three.js for its page; the browser tests' headless chromium and its driver
   libjs-three chromium chromium-driver
+  # the LAS export test: PROJ (python3-pyproj) places the expected points (node runs copc.js: below)
+  python3-pyproj
 )
 
 if [ "$(id -u)" -ne 0 ]; then
@@ -39,6 +41,11 @@ missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# Node.js and npm run the LAS test's reader (copc.js, from the npm registry): Debian's, unless the
+# machine already has a Node.js with npm (its own packages must not be replaced).
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  missing+=(nodejs npm)
+fi
 if [ "${#missing[@]}" -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages already installed"
   exit 0

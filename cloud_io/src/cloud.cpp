@@ -44,20 +44,22 @@ Cloud from_points(const trajroi::points_t& m) {
            static_cast<float>(static_cast<double>(m.time_offset_ns[i]) * 1e-9),
            static_cast<std::uint8_t>(m.return_type[i]));
   }
+  c.start_utc_ns = m.sweep_start_utc_ns;
+  c.return_mode = static_cast<std::uint8_t>(m.return_mode);
   c.comment = "trajroi: sweep " + std::to_string(m.sweep_index) + ", trajectory " + std::to_string(m.trajectory_id) +
               ", global frame (x east, y north, z up, m)";
   return c;
 }
 
-void Accumulator::add(const trajroi::points_t& m) {
+void Accumulator::add(const Cloud& sweep, std::int64_t sweep_start_ns) {
   if (sweeps_++ == 0) {
-    first_start_ns_ = m.sweep_start_ns;
-    cloud_.comment = "trajroi: accumulated map from sweep " + std::to_string(m.sweep_index) +
-                     ", global frame (x east, y north, z up, m)";
+    first_start_ns_ = sweep_start_ns;
+    cloud_.start_utc_ns = sweep.start_utc_ns;
+    cloud_.return_mode = sweep.return_mode;
+    cloud_.comment = "trajroi: accumulated map; the first: " + sweep.comment;
   }
-  const double offset_s = static_cast<double>(m.sweep_start_ns - first_start_ns_) * 1e-9;
-  const auto n = static_cast<std::size_t>(std::max(0, m.num_points));
-  for (std::size_t i = 0; i < n; ++i) {
+  const double offset_s = static_cast<double>(sweep_start_ns - first_start_ns_) * 1e-9;
+  for (std::size_t i = 0; i < sweep.size(); ++i) {
     if (voxel_m_ > 0.0) {
       // 21 bits per axis: ±1 048 km at 1 m voxels, ±10 km at 1 cm.
       const auto cell = [this](float v) {
@@ -65,12 +67,11 @@ void Accumulator::add(const trajroi::points_t& m) {
                                           (1 << 20)) &
                0x1FFFFF;
       };
-      const std::uint64_t key = (cell(m.x[i]) << 42) | (cell(m.y[i]) << 21) | cell(m.z[i]);
+      const std::uint64_t key = (cell(sweep.x[i]) << 42) | (cell(sweep.y[i]) << 21) | cell(sweep.z[i]);
       if (!occupied_.insert(key).second) continue;
     }
-    cloud_.push(m.x[i], m.y[i], m.z[i], static_cast<float>(m.intensity[i]), static_cast<std::uint8_t>(m.ring[i]),
-                static_cast<float>(offset_s + static_cast<double>(m.time_offset_ns[i]) * 1e-9),
-                static_cast<std::uint8_t>(m.return_type[i]));
+    cloud_.push(sweep.x[i], sweep.y[i], sweep.z[i], sweep.intensity[i], sweep.ring[i],
+                static_cast<float>(offset_s + static_cast<double>(sweep.time_s[i])), sweep.return_type[i]);
   }
 }
 

@@ -18,6 +18,11 @@ struct Cloud {
   std::vector<std::uint16_t> ring;
   std::vector<std::uint8_t> return_type;
   std::string comment;  // one line: where the points come from (sweep, frame)
+  // UTC of time_s = 0, ns since 1970 (points_t.sweep_start_utc_ns; 0: unknown, as in a replay
+  // without a PPS-locked sensor).
+  std::int64_t start_utc_ns = 0;
+  // The return mode the points were taken in (points_t.return_mode: 0x39 dual).
+  std::uint8_t return_mode = 0;
 
   [[nodiscard]] std::size_t size() const noexcept { return x.size(); }
   void clear();
@@ -33,7 +38,9 @@ struct Cloud {
 class Accumulator {
  public:
   explicit Accumulator(double voxel_m) : voxel_m_(voxel_m) {}
-  void add(const trajroi::points_t& m);
+  void add(const trajroi::points_t& m) { add(from_points(m), m.sweep_start_ns); }
+  // A sweep's cloud (times after its start) that started at `sweep_start_ns` (host clock).
+  void add(const Cloud& sweep, std::int64_t sweep_start_ns);
   [[nodiscard]] const Cloud& cloud() const noexcept { return cloud_; }
   [[nodiscard]] std::size_t sweeps() const noexcept { return sweeps_; }
 
