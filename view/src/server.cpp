@@ -300,7 +300,12 @@ bool ViewServer::start_next(Client& c, std::int64_t now_ns) {
     if (rate_capped(k)) {
       std::int64_t& next = c.next_ns[static_cast<std::size_t>(k)];
       if (now_ns < next) continue;
-      next = now_ns + static_cast<std::int64_t>(1e9 / options_.max_sweep_rate_hz);
+      // Spaced from when the previous one was due, not sent: a sensor at the cap's own rate
+      // whose sweeps come a little early or late is not pushed a period behind (its latency
+      // grew by its jitter at every sweep, to a whole period, with next = now + period). A
+      // page back after a pause starts afresh.
+      const auto period = static_cast<std::int64_t>(1e9 / options_.max_sweep_rate_hz);
+      next = next + period < now_ns ? now_ns + period : next + period;
     }
     c.header_size = server_frame_header(Opcode::kBinary, q->size(), c.header);
     c.body = std::move(q);
