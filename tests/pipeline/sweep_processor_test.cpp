@@ -288,3 +288,61 @@ TEST(SweepProcessor, APoseJumpBackAlongTheTrajectoryIsFoundAgain) {
 }
 
 }  // namespace
+
+namespace {
+
+// outputs.raw_points: a sweep carries one in N of its decoded points (by index in the sweep),
+// placed in the global frame exactly as the points the ROI was given (on_placed), whether the
+// ROI kept them or not; nothing when it is off, nothing for a sweep without a pose.
+struct PlacedAndSwept final : trajroi::pipeline::SweepSink {
+  std::vector<trajroi::roi::PointXYZI> placed;  // the current sweep's, by index
+  std::vector<std::vector<trajroi::roi::PointXYZI>> placed_by_sweep;
+  std::vector<trajroi::pipeline::Sweep> sweeps;
+  void on_placed(const trajroi::vlp16::Frame&, std::size_t first,
+                 std::span<const trajroi::roi::PointXYZI> points) override {
+    if (first == 0) placed.clear();
+    placed.resize(first);
+    placed.insert(placed.end(), points.begin(), points.end());
+  }
+  void on_sweep(trajroi::pipeline::Sweep& s) override {
+    sweeps.push_back(s);
+    placed_by_sweep.push_back(s.filtered ? placed : std::vector<trajroi::roi::PointXYZI>{});
+    placed.clear();
+  }
+};
+
+TEST(SweepProcessor, RawPointsAreOneInNOfTheDecodedPointsAsPlaced) {
+  DaemonConfig config = run_config();
+  config.outputs.raw_points = true;
+  config.outputs.raw_points_decimation = 3;
+  trajroi::pipeline::SweepProcessor processor(config, trajectory_from(config.trajectory_file, 0));
+  PlacedAndSwept sink;
+  for (const Event& e : run_events())
+    processor.process(e.item(), sink);
+  processor.flush(sink);
+  std::size_t checked = 0;
+  for (std::size_t k = 0; k < sink.sweeps.size(); ++k) {
+    const Sweep& s = sink.sweeps[k];
+    if (!s.filtered) {
+      EXPECT_EQ(s.raw.size(), 0u) << "sweep " << s.index;
+      continue;
+    }
+    const auto& placed = sink.placed_by_sweep[k];
+    ASSERT_EQ(placed.size(), s.points_in) << "sweep " << s.index;
+    ASSERT_EQ(s.raw.size(), (s.points_in + 2) / 3) << "sweep " << s.index;
+    for (std::size_t i = 0; i < s.raw.size(); ++i) {
+      ASSERT_EQ(s.raw.x[i], placed[3 * i].x) << "sweep " << s.index << " point " << 3 * i;
+      ASSERT_EQ(s.raw.y[i], placed[3 * i].y);
+      ASSERT_EQ(s.raw.z[i], placed[3 * i].z);
+    }
+    ++checked;
+  }
+  EXPECT_GT(checked, 200u);
+
+  config.outputs.raw_points = false;
+  trajroi::pipeline::SweepProcessor off(config, trajectory_from(config.trajectory_file, 0));
+  for (const Sweep& s : drive(off).sweeps)
+    ASSERT_EQ(s.raw.size(), 0u);
+}
+
+}  // namespace

@@ -112,6 +112,15 @@ def main():
         wait_for("sweeps drawn after reconnecting", lambda: stats()["sweepsDrawn"] >= before + 5, 30)
         print("ok: reconnected and drew %d more sweeps" % (stats()["sweepsDrawn"] - before))
 
+        # A planner replaces the trajectory (shifted 0.5 m north): trajroid takes it at a sweep's
+        # start and publishes it as the active one; the page draws it.
+        waypoints = [tuple(float(v) for v in line.split(","))
+                     for line in open(os.path.join(run, "trajectory.csv")) if line[0] not in "#xl\n"]
+        shifted = [(x, y + 0.5) for x, y in waypoints]
+        trajroi_lcm.Publisher(url).publish("TRAJROI_TRAJECTORY", trajroi_lcm.trajectory(7, shifted))
+        wait_for("the page to draw trajectory 7", lambda: stats()["trajectoryId"] == 7, 5)
+        print("ok: the page drew trajectory 7 within 5 s of its message")
+
         # Paused on a sweep with its decoded points: the counters, the DOM and the picture.
         wait_for("decoded points of the shown sweep",
                  lambda: stats().get("rawSweep") is not None and stats()["rawSweep"] == stats()["lastSweep"], 20)
@@ -145,7 +154,7 @@ def main():
                     p.kill()
 
     # What trajroid published, as lcm-logger logged it.
-    points, rois, raws = {}, {}, {}
+    points, rois, raws, trajectories = {}, {}, {}, []
     for channel, _, data in trajroi_lcm.read_log(log_path):
         if channel == "TRAJROI_POINTS":
             m = trajroi_lcm.decode(data)
@@ -156,6 +165,8 @@ def main():
         elif channel == "TRAJROI_RAW_POINTS":
             m = trajroi_lcm.decode(data)
             raws[m.sweep_index] = m
+        elif channel == "TRAJROI_ACTIVE_TRAJECTORY":
+            trajectories.append(trajroi_lcm.decode(data))
     check(len(points) > 100, "lcm-logger logged %d sweeps" % len(points))
     expected = "sweeps received %d · sweep %d · points %d · ROIs %d" % (
         shown["sweepsReceived"], shown["lastSweep"], points[shown["lastSweep"]].num_points,
@@ -168,6 +179,19 @@ def main():
     check(shown["rawDrawn"] == raw.num_points,
           "decoded points drawn %d = raw points_t of sweep %d: %d (of %d decoded)" % (
               shown["rawDrawn"], shown["rawSweep"], raw.num_points, raw.points_in))
+
+    # The active trajectory trajroid published (once a second): the run's (id 0), then the
+    # planner's (id 7), in the global frame, as the sweeps used them.
+    check(len(trajectories) >= 10, "%d active trajectory messages (one a second)" % len(trajectories))
+    for wanted, expected in ((0, waypoints), (7, shifted)):
+        t = [m for m in trajectories if m.id == wanted]
+        check(t and t[-1].coordinates == t[-1].GLOBAL_XY and t[-1].num_waypoints == len(expected) and
+              all(abs(u - w[0]) < 1e-6 and abs(v - w[1]) < 1e-6 for u, v, w in zip(t[-1].u, t[-1].v, expected)),
+              "active trajectory %d published with its %d waypoints" % (wanted, len(expected)))
+    first7 = min(i for i, m in points.items() if m.trajectory_id == 7)
+    check(all(m.trajectory_id == (7 if i >= first7 else 0) for i, m in points.items()),
+          "every sweep from %d was filtered against trajectory 7, every one before against 0" % first7)
+    check(shown["trajectoryId"] == 7, "the page shows trajectory 7")
 
     width, height, pixel = png.read_png(shot)
     background = (0x10, 0x14, 0x18)

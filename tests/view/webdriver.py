@@ -5,7 +5,9 @@ import base64
 import json
 import os
 import socket
+import shutil
 import subprocess
+import tempfile
 import time
 import urllib.request
 
@@ -19,6 +21,7 @@ def free_port():
 class Browser:
     def __init__(self, width=1280, height=800):
         self.port = free_port()
+        self.profile = tempfile.mkdtemp(prefix="trajroi-chromium-")
         self.driver = subprocess.Popen(
             ["chromedriver", "--port=%d" % self.port], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         deadline = time.time() + 20
@@ -32,7 +35,7 @@ class Browser:
                 time.sleep(0.1)
         args = ["--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--use-angle=swiftshader",
                 "--enable-unsafe-swiftshader", "--window-size=%d,%d" % (width, height),
-                "--user-data-dir=/tmp/trajroi-chromium-%d" % os.getpid()]
+                "--user-data-dir=" + self.profile]
         caps = {"capabilities": {"alwaysMatch": {
             "browserName": "chrome", "goog:chromeOptions": {"binary": "/usr/bin/chromium", "args": args}}}}
         self.session = self._call("POST", "/session", caps)["sessionId"]
@@ -69,6 +72,7 @@ class Browser:
         finally:
             self.driver.terminate()
             self.driver.wait(10)
+            shutil.rmtree(self.profile, ignore_errors=True)
 
 
 def port_open(port):
