@@ -11,6 +11,7 @@
 #include <span>
 
 #include "trajroi/framing/checksums.hpp"
+#include "trajroi/framing/rtcm3.hpp"
 
 namespace trajroi::framing {
 
@@ -22,17 +23,16 @@ struct SnifferCounters {
 
 class ProtocolSniffer {
  public:
-  void feed(std::span<const std::uint8_t> bytes) noexcept {
+  void feed(std::span<const std::uint8_t> bytes) {
     for (const std::uint8_t b : bytes) {
       text(b);
-      rtcm(b);
     }
+    rtcm_.feed(bytes, [this](std::span<const std::uint8_t>) { ++counters_.rtcm3_frames; });
   }
   [[nodiscard]] const SnifferCounters& counters() const noexcept { return counters_; }
 
  private:
   static constexpr std::size_t kMaxLine = 128;  // NMEA allows 82; VectorNav's lines are longer
-  static constexpr std::size_t kMaxRtcm = 3 + 1023 + 3;
 
   static int hex(std::uint8_t c) noexcept {
     if (c >= '0' && c <= '9') return c - '0';
@@ -94,50 +94,12 @@ class ProtocolSniffer {
     }
   }
 
-  // A frame from 0xD3: 6 reserved zero bits, a 10-bit length, the message, CRC-24Q. A start
-  // that fails (a 0xD3 inside other bytes) is dropped and the bytes after it looked at again,
-  // so a real frame that began inside a false one is still found.
-  void rtcm(std::uint8_t b) noexcept {
-    if (rtcm_size_ == 0 && b != 0xD3) return;
-    rtcm_[rtcm_size_++] = b;
-    for (;;) {
-      if (rtcm_size_ >= 2 && (rtcm_[1] & 0xFC) != 0) {
-        drop_start();
-        continue;
-      }
-      if (rtcm_size_ < 3) return;
-      const std::size_t length = (static_cast<std::size_t>(rtcm_[1] & 0x03) << 8) | rtcm_[2];
-      if (rtcm_size_ < 3 + length + 3) return;
-      const std::uint32_t written = (static_cast<std::uint32_t>(rtcm_[3 + length]) << 16) |
-                                    (static_cast<std::uint32_t>(rtcm_[4 + length]) << 8) | rtcm_[5 + length];
-      if (length == 0 || crc24q(std::span<const std::uint8_t>(rtcm_.data(), 3 + length)) != written) {
-        drop_start();
-        continue;
-      }
-      ++counters_.rtcm3_frames;
-      const std::size_t used = 6 + length;
-      for (std::size_t i = used; i < rtcm_size_; ++i)
-        rtcm_[i - used] = rtcm_[i];
-      rtcm_size_ -= used;
-      if (rtcm_size_ == 0) return;
-      if (rtcm_[0] != 0xD3) drop_start();
-    }
-  }
-  // Drops the buffer's first byte and whatever follows up to the next 0xD3.
-  void drop_start() noexcept {
-    std::size_t next = 1;
-    while (next < rtcm_size_ && rtcm_[next] != 0xD3)
-      ++next;
-    for (std::size_t i = next; i < rtcm_size_; ++i)
-      rtcm_[i - next] = rtcm_[i];
-    rtcm_size_ -= next;
-  }
-
   std::array<std::uint8_t, kMaxLine> line_{};
   std::size_t line_size_ = 0;
   bool in_line_ = false;
-  std::array<std::uint8_t, kMaxRtcm> rtcm_{};
-  std::size_t rtcm_size_ = 0;
+  // RTCM3 frames: a start that fails (a 0xD3 inside other bytes) is dropped one byte on, so a
+  // real frame that began inside a false one is still found.
+  Rtcm3Framer rtcm_;
   SnifferCounters counters_;
 };
 
