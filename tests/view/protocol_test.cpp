@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "trajroi/text/base64.hpp"
 #include "trajroi/view/frames.hpp"
 #include "trajroi/view/http.hpp"
 #include "trajroi/view/websocket.hpp"
@@ -37,6 +38,7 @@ TEST(Sha1, Fips180TestVectors) {
 }
 
 TEST(Base64, Rfc4648Vectors) {
+  using text::base64;
   EXPECT_EQ(base64(bytes("")), "");
   EXPECT_EQ(base64(bytes("f")), "Zg==");
   EXPECT_EQ(base64(bytes("fo")), "Zm8=");

@@ -15,8 +15,6 @@ namespace trajroi::view {
 
 // SHA-1 (FIPS 180-4) of `bytes`: the handshake's only use of it.
 [[nodiscard]] std::array<std::uint8_t, 20> sha1(std::span<const std::uint8_t> bytes);
-// Base64 (RFC 4648, with padding).
-[[nodiscard]] std::string base64(std::span<const std::uint8_t> bytes);
 // Sec-WebSocket-Accept for a client's Sec-WebSocket-Key: base64(SHA-1(key + the RFC's GUID)).
 [[nodiscard]] std::string websocket_accept(std::string_view key);
 

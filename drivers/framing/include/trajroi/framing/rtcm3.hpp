@@ -15,7 +15,7 @@
 
 namespace trajroi::framing {
 
-inline constexpr std::size_t kRtcm3Overhead = 6;            // preamble, length (2), CRC (3)
+inline constexpr std::size_t kRtcm3Overhead = 6;  // preamble, length (2), CRC (3)
 inline constexpr std::size_t kRtcm3MaxFrame = 1023 + kRtcm3Overhead;
 
 // The StreamFramer protocol of RTCM3 frames. A zero-length frame carries no message and is
@@ -32,8 +32,8 @@ struct Rtcm3Protocol {
   }
   [[nodiscard]] static bool checksum_ok(std::span<const std::uint8_t> frame) noexcept {
     const std::size_t n = frame.size() - 3;
-    const std::uint32_t written = static_cast<std::uint32_t>(frame[n]) << 16 |
-                                  static_cast<std::uint32_t>(frame[n + 1]) << 8 | frame[n + 2];
+    const std::uint32_t written =
+        static_cast<std::uint32_t>(frame[n]) << 16 | static_cast<std::uint32_t>(frame[n + 1]) << 8 | frame[n + 2];
     return crc24q(frame.first(n)) == written;
   }
 };
