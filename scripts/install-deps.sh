@@ -26,6 +26,8 @@ packages=(
   pcl-tools python3-open3d
   # trajroi view: three.js for its page; the browser tests' headless chromium and its driver
   libjs-three chromium chromium-driver
+  # the NTRIP client's tests: RTKLIB's str2str as a real caster
+  rtklib
   # the LAS export test: PROJ (python3-pyproj) places the expected points (node runs copc.js: below)
   python3-pyproj
 )

@@ -94,10 +94,13 @@ TEST(SourceTable, StreamRecords) {
       "STR;FFMJ00DEU0;Frankfurt;RTCM 3.3;1005(10),1077(1),1087(1);2;GPS+GLO;EUREF;DEU;50.09;8.66;0;0;"
       "Trimble;none;B;N;4400;\r\n"
       "STR;VRS_MSM;Network VRS;RTCM 3.2;1004(1);2;GPS;NET;DEU;51.00;10.00;1;1;sNTRIP;none;B;N;9600;\r\n"
-      "STR;short;only;five\r\n"
+      "STR;F9T;RTKLIB's caster sends three fields\r\n"
+      "STR;\r\n"
       "ENDSOURCETABLE\r\n";
   const auto streams = parse_source_table(body);
-  ASSERT_EQ(streams.size(), 2U);
+  ASSERT_EQ(streams.size(), 3U);
+  EXPECT_EQ(streams[2].mountpoint, "F9T");
+  EXPECT_EQ(streams[2].format, "");
   EXPECT_EQ(streams[0].mountpoint, "FFMJ00DEU0");
   EXPECT_EQ(streams[0].format, "RTCM 3.3");
   EXPECT_EQ(streams[0].nav_system, "GPS+GLO");

@@ -168,8 +168,10 @@ std::vector<SourceTableStream> parse_source_table(std::string_view body) {
   for (std::string_view line : split(body, '\n')) {
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (!line.starts_with("STR;")) continue;
-    const std::vector<std::string_view> f = split(line, ';');
-    if (f.size() < 12) continue;
+    std::vector<std::string_view> f = split(line, ';');
+    if (f.size() < 2 || f[1].empty()) continue;
+    // RTCM 10410.1 gives 19 fields; some casters (RTKLIB's) send fewer: the missing are empty.
+    f.resize(std::max<std::size_t>(f.size(), 12));
     SourceTableStream s;
     s.mountpoint = std::string(f[1]);
     s.identifier = std::string(f[2]);

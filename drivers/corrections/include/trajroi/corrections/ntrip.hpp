@@ -59,8 +59,9 @@ struct SourceTableStream {
   bool wants_gga = false;  // field 12 "nmea": 1 when the caster needs the rover's position (VRS)
 };
 
-// The STR records of a source table body ("STR;mountpoint;identifier;format;…"); other
-// records (CAS, NET) and malformed lines are left out.
+// The STR records of a source table body ("STR;mountpoint;identifier;format;…"; fields a
+// caster leaves out are empty); other records (CAS, NET) and lines without a mountpoint are
+// left out.
 [[nodiscard]] std::vector<SourceTableStream> parse_source_table(std::string_view body);
 
 // HTTP/1.1 chunked transfer decoding (RFC 9112 §7.1), resumable across reads.
