@@ -14,7 +14,7 @@ shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
   targets=(vlp16_packets pcap_source ubx vn100 daemon_config trajectory_csv trajectory_message scenario vlp16_calibration
-    lcm_udpm view_protocol)
+    lcm_udpm view_protocol ntrip_answer)
 fi
 data=${TRAJROI_DATA_DIR:-$(pwd)/../shared/data}
 if [ ! -d "$data" ]; then
@@ -76,7 +76,7 @@ max_len() {
   case $1 in
     vlp16_packets | pcap_source) echo 65536 ;;
     lcm_udpm) echo 262144 ;;
-    ubx | vn100 | view_protocol) echo 16384 ;;
+    ubx | vn100 | view_protocol | ntrip_answer) echo 16384 ;;
     *) echo 8192 ;;
   esac
 }

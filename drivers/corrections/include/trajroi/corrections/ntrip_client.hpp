@@ -7,7 +7,9 @@
 // stalled stream, and reconnects with a backoff doubling from backoff_min_s to backoff_max_s.
 // Every change of state is said in words through the event callback ("connected to …",
 // "refused by the caster: HTTP/1.0 401 Unauthorized", "mountpoint X is not on the caster; it
-// has: A, B", "caster closed the connection", "no data for 10.0 s").
+// has: A, B", "caster closed the connection", "no data for 10.0 s"). Resolving the caster's
+// name (getaddrinfo) may block the calling thread for the resolver's timeout: run the client
+// on a thread of its own, never one of the pipeline's.
 #include <cstdint>
 #include <functional>
 #include <map>
