@@ -188,9 +188,18 @@
         ++shapes;
       });
     }
-    var g = roiLines.geometry;
-    var attribute = new THREE.BufferAttribute(new Float32Array(positions), 3);
-    g.setAttribute ? g.setAttribute('position', attribute) : g.addAttribute('position', attribute);
+    // Written into the attribute in place (grown when a longer chain comes): a new buffer per
+    // sweep would leave the GPU one buffer more to free ten times a second.
+    var g = roiLines.geometry, attribute = g.getAttribute('position');
+    if (!attribute || attribute.array.length < positions.length) {
+      attribute = new THREE.BufferAttribute(new Float32Array(Math.max(positions.length, 3 * 4096)), 3);
+      attribute.setUsage ? attribute.setUsage(THREE.DynamicDrawUsage) : attribute.setDynamic(true);
+      g.setAttribute ? g.setAttribute('position', attribute) : g.addAttribute('position', attribute);
+    }
+    attribute.array.set(positions);
+    attribute.updateRange.offset = 0;
+    attribute.updateRange.count = positions.length;
+    attribute.needsUpdate = true;
     g.setDrawRange(0, positions.length / 3);
     return shapes;
   }
