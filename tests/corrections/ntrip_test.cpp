@@ -86,6 +86,12 @@ TEST(NtripAnswer, TheCastersAnswers) {
   EXPECT_EQ(parse_ntrip_answer(std::string_view("\xD3\x00\x13>\xD0\x00\x03\x8A\r\n", 10)).kind,
             NtripAnswer::Kind::kGarbage);
   EXPECT_EQ(parse_ntrip_answer("SSH-2.0-OpenSSH_9.2\r\n").kind, NtripAnswer::Kind::kGarbage);
+  // A status that is not three digits is no status (the fuzzer's first find: 28 digits overflowed an int).
+  const NtripAnswer huge = parse_ntrip_answer("HTTP/1.1 2555555555555555555555555500 OK\r\n\r\n");
+  EXPECT_EQ(huge.kind, NtripAnswer::Kind::kRefused);
+  EXPECT_EQ(huge.status, 0);
+  EXPECT_EQ(parse_ntrip_answer("HTTP/1.1 2e2 OK\r\n\r\n").status, 0);
+  EXPECT_EQ(parse_ntrip_answer("HTTP/1.1 200.0 OK\r\n\r\n").kind, NtripAnswer::Kind::kRefused);
 }
 
 TEST(SourceTable, StreamRecords) {

@@ -32,6 +32,17 @@ double number(std::string_view s) {
   return ec == std::errc() && end == s.data() + s.size() ? v : 0.0;
 }
 
+// An HTTP status code: exactly three digits (RFC 9110 section 15), else 0.
+int status_code(std::string_view s) {
+  if (s.size() != 3) return 0;
+  int v = 0;
+  for (const char c : s) {
+    if (c < '0' || c > '9') return 0;
+    v = v * 10 + (c - '0');
+  }
+  return v;
+}
+
 }  // namespace
 
 std::string NtripUrl::redacted() const {
@@ -145,7 +156,7 @@ NtripAnswer parse_ntrip_answer(std::string_view bytes, bool closed) {
     a.head_bytes = head_end + 4;
   }
   const std::vector<std::string_view> words = split(line, ' ');
-  a.status = words.size() > 1 ? static_cast<int>(number(words[1])) : 0;
+  a.status = words.size() > 1 ? status_code(words[1]) : 0;
   bool table_body = sourcetable;
   const std::string_view headers =
       head_end > line_end + 2 ? bytes.substr(line_end + 2, head_end - line_end - 2) : std::string_view();
