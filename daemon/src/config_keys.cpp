@@ -116,9 +116,17 @@ std::vector<ConfigKey> make_keys() {
       "gate: horizontal accuracy estimate at most this (a standalone receiver reports 1–3 m; 0.05 "
       "insists on RTK-grade fixes)",
       Sign::kPositive, [](auto& c) -> auto& { return c.gate.max_h_acc_m; }));
-  k.push_back(flag_key(
-      "pose.require_rtk_fixed", "gate: only an RTK fixed carrier solution",
-      [](auto& c) -> auto& { return c.gate.require_rtk_fixed; }));
+  k.push_back({"pose.require_rtk", "none | float | fixed",
+               "gate: at least this RTK carrier solution (NAV-PVT carrSoln; needs corrections: gnss.corrections)",
+               false,
+               [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
+                 const std::string s =
+                     m.choice(key, {"none", "float", "fixed"}, std::string(pose::to_string(c.gate.require_rtk)));
+                 c.gate.require_rtk = s == "fixed"   ? pose::RtkSolution::kFixed
+                                      : s == "float" ? pose::RtkSolution::kFloat
+                                                     : pose::RtkSolution::kNone;
+               },
+               [](const DaemonConfig& c) { return std::string(pose::to_string(c.gate.require_rtk)); }});
   k.push_back(
       {"pose.max_extrapolation_s", "number ≥ 0",
        "gate: past the newest fix / attitude (a GNSS period + its delay: 0.5 covers 4 Hz and faster; a 1 Hz "

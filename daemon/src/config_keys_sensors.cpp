@@ -3,9 +3,11 @@
 #include <sys/stat.h>
 
 #include <cmath>
+#include <stdexcept>
 
 #include "config_key_makers.hpp"
 #include "trajroi/config/origin.hpp"
+#include "trajroi/corrections/corrections_url.hpp"
 #include "trajroi/serial/serial_port_source.hpp"
 
 namespace trajroi::daemon::config_keys_detail {
@@ -181,6 +183,35 @@ void add_sensor_keys(std::vector<ConfigKey>& k) {
                  c.gnss_antenna_m = Eigen::Vector3d(a[0], a[1], a[2]);
                },
                [](const DaemonConfig& c) { return format_vector(c.gnss_antenna_m); }});
+  k.push_back({"gnss.corrections.url", "URL or \"\"",
+               "RTK corrections written into the receiver through gnss.device: ntrip://user:password@host:port/MOUNT, "
+               "tcp://host:port, udp://[address]:port, serial:///dev/ttyUSB1?baud=57600 (a radio), lcm://CHANNEL "
+               "(rtcm_t); empty: none",
+               false,
+               [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
+                 c.gnss_corrections.url = m.text(key, c.gnss_corrections.url);
+                 if (c.gnss_corrections.url.empty()) return;
+                 try {
+                   (void)corrections::parse_corrections_url(c.gnss_corrections.url);
+                 } catch (const std::invalid_argument& e) {
+                   m.require(false, key, e.what());
+                 }
+               },
+               [](const DaemonConfig& c) {
+                 if (c.gnss_corrections.url.empty()) return std::string();
+                 return corrections::parse_corrections_url(c.gnss_corrections.url).redacted();
+               }});
+  k.push_back(real_key(
+      "gnss.corrections.gga_interval_s", "number ≥ 0",
+      "NTRIP: the rover's position (GGA) sent to the caster this often, for VRS mountpoints (0: never)",
+      Sign::kNonNegative, [](auto& c) -> auto& { return c.gnss_corrections.gga_interval_s; }));
+  k.push_back(real_key(
+      "gnss.corrections.stall_s", "number > 0", "no corrections byte for this long: the stream is lost (reconnect)",
+      Sign::kPositive, [](auto& c) -> auto& { return c.gnss_corrections.stall_s; }));
+  k.push_back(real_key(
+      "gnss.max_correction_age_s", "number > 0",
+      "the newest corrections frame written into the receiver longer ago than this is warned", Sign::kPositive,
+      [](auto& c) -> auto& { return c.gnss_corrections.max_age_s; }));
   add_serial_keys(k, &DaemonConfig::imu, false);
   k.push_back({"imu.magnetic_declination_deg", "number in [-180, 180]",
                "added to the VN-100's magnetic heading, positive east", false,

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <thread>
 
+#include "corrections_link.hpp"
 #include "status.hpp"
 
 namespace trajroi::daemon {

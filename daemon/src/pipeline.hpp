@@ -134,6 +134,7 @@ struct TrajectoryItem {
 };
 
 struct StatusSnapshot;
+class CorrectionsLink;
 
 struct Pipeline {
   // `exact`: an as-fast-as-possible replay, where a full ring is waited on (the output is
@@ -175,6 +176,8 @@ struct Pipeline {
   Ring<TrajectoryItem> trajectories_out;    // processing → publisher (to free)
   std::unique_ptr<Lane<InputSlot>> record;  // processing → recorder, when recording
   std::string record_dir;                   // its folder (set before the threads start)
+  // gnss.corrections on a live GNSS port (set before the threads start; else null).
+  std::unique_ptr<CorrectionsLink> corrections;
   std::atomic<bool> record_failed{false};   // the recorder stopped on an error (logged)
   std::atomic<bool> processing_done{false}, publishing_done{false};
   // The processing thread is about to wait for input, or waits: an as-fast-as-possible

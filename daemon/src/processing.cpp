@@ -5,6 +5,7 @@
 #include <limits>
 #include <thread>
 
+#include "corrections_link.hpp"
 #include "log.hpp"
 #include "realtime.hpp"
 #include "status.hpp"
@@ -79,6 +80,12 @@ class Processing {
       sink_.packet_done(host::monotonic_ns());
     } else {
       processor_.process(input, sink_);
+      // A new NAV-PVT: the rover's position for the corrections' caster (GGA).
+      if (pipeline_.corrections && item.stream == inputs::Stream::kGnss) {
+        const pose_input::PoseInput& pose = processor_.pose_input();
+        if (pose.pvt_count() != pvt_seen_ && pose.newest_pvt()) pipeline_.corrections->offer_rover(*pose.newest_pvt());
+        pvt_seen_ = pose.pvt_count();
+      }
     }
     if (pipeline_.record) (void)pipeline_.record->push([&item](InputSlot& slot) { slot = item; });
     lane.ring->release();
@@ -156,6 +163,7 @@ class Processing {
   pipeline::SweepProcessor& processor_;
   RingSink sink_;
   std::int64_t last_receive_ns_ = 0;
+  std::uint64_t pvt_seen_ = 0;
 };
 
 }  // namespace

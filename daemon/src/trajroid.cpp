@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "corrections_link.hpp"
 #include "lcm_pose_input.hpp"
 #include "log.hpp"
 #include "outlet.hpp"
@@ -45,6 +46,7 @@ inputs::SerialInput::OnOpen receiver_configuration(const DaemonConfig& config, i
       s.rate_hz = config.gnss.rate_hz;
       s.port = configure::guess_ublox_port(config.gnss.device);
       s.relposned = config.pose_source == PoseSource::kGnss;
+      s.rtcm3_input = !config.gnss_corrections.url.empty();
       r = configure::configure_ublox(port, s);
     } else {
       configure::Vn100Settings s;
@@ -64,6 +66,8 @@ inputs::SerialInput::OnOpen receiver_configuration(const DaemonConfig& config, i
 void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions& options,
                 const std::optional<sockaddr_in>& own_source) {
   if (options.replay) {
+    if (!config.gnss_corrections.url.empty())
+      log::info("gnss.corrections.url: not used in a replay (no receiver to write into)");
     inputs::RecordedOptions recorded;
     recorded.rate = options.rate;
     recorded.loop = options.loop;
@@ -95,12 +99,24 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
     o.max_backoff = std::chrono::milliseconds(500);
     auto input = std::make_unique<inputs::SerialInput>(name, stream, o);
     if (s.configure) input->on_open(receiver_configuration(config, stream));
+    if (stream == inputs::Stream::kGnss && !config.gnss_corrections.url.empty()) {
+      pipeline.corrections = std::make_unique<CorrectionsLink>(config, options.lcm_url.empty() ? config.lcm.url
+                                                                                               : options.lcm_url);
+      pipeline.corrections->open();  // a UDP port or LCM that cannot be opened: named, exit 1
+      CorrectionsLink* link = pipeline.corrections.get();
+      input->before_read([link](serial::SerialPortSource& port) { link->write_waiting(port); });
+    }
     pipeline.add_input(std::move(input), config.buffers.serial_chunks, std::string("trajroid-") + name, thread,
                        Pipeline::Lidar::kNone);
   };
   // What the pose source reads (a device configured for an unused stream is left closed).
   if (config.pose_source == PoseSource::kGnssImu || config.pose_source == PoseSource::kGnss) {
     add_serial(config.gnss, "gnss", inputs::Stream::kGnss, config.realtime.gnss);
+  }
+  if (!config.gnss_corrections.url.empty() && !pipeline.corrections) {
+    log::warn("gnss.corrections.url is set but trajroid reads no GNSS port (pose.source {}, gnss.device \"{}\"): "
+              "no corrections are taken",
+              to_string(config.pose_source), config.gnss.device);
   }
   if (config.pose_source == PoseSource::kGnssImu)
     add_serial(config.imu, "imu", inputs::Stream::kImu, config.realtime.imu);
@@ -167,6 +183,7 @@ int run_pipeline(Pipeline& pipeline, pipeline::SweepProcessor& processor, Outlet
   threads.emplace_back([&] { processing_loop(pipeline, processor, processing); });
   threads.emplace_back([&] { publisher.run(); });
   if (pipeline.record) threads.emplace_back([&] { recorder_loop(pipeline, *options.record); });
+  if (pipeline.corrections) threads.emplace_back([&] { pipeline.corrections->run(pipeline.stop); });
   for (const auto& lane : pipeline.inputs)
     threads.emplace_back([&pipeline, &lane] { input_loop(pipeline, *lane); });
   sd_notify(0, "READY=1\nSTATUS=running");

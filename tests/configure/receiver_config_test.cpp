@@ -83,12 +83,14 @@ ScriptedDevice::Answer ublox_device(
 
 constexpr std::uint8_t kClassCfg = 0x06, kIdValset = 0x8A, kIdMsg = 0x01, kIdRate = 0x08;
 
-configure::Result run_ublox(ScriptedDevice& device) {
+configure::Result run_ublox(ScriptedDevice& device, bool rtcm3_input = false) {
   serial::SerialPortOptions o;
   o.device = device.path();
   serial::SerialPortSource port(o);
   configure::UbloxSettings s;
   s.timeout = std::chrono::milliseconds(300);
+  s.port = ublox::Port::kUart1;
+  s.rtcm3_input = rtcm3_input;
   return configure::configure_ublox(port, s);
 }
 
@@ -109,8 +111,28 @@ TEST(ReceiverConfig, AnF9TakesOneValsetAndAcksIt) {
   EXPECT_TRUE(r.ok) << steps(r);
   ASSERT_EQ(seen.size(), 1u);
   EXPECT_EQ(seen[0], std::make_pair(kClassCfg, kIdValset));
-  EXPECT_NE(r.summary.find("u-blox F9 configured: NAV-PVT, NAV-HPPOSLLH at 5 Hz on USB"), std::string::npos)
+  EXPECT_NE(r.summary.find("u-blox F9 configured: NAV-PVT, NAV-HPPOSLLH at 5 Hz on UART1"), std::string::npos)
       << r.summary;
+}
+
+// gnss.corrections: a second CFG-VALSET sets CFG-UART1INPROT-RTCM3X (0x10730004, the interface
+// description's key) to 1; its ACK is checked, a NAK named.
+TEST(ReceiverConfig, RtcmInputIsSetOnThePortAndItsRefusalNamed) {
+  for (const bool accept : {true, false}) {
+    std::vector<std::vector<std::uint8_t>> valsets;
+    ScriptedDevice f9(ublox_device([&](std::uint8_t c, std::uint8_t i, std::span<const std::uint8_t> payload) {
+      if (c == kClassCfg && i == kIdValset) valsets.emplace_back(payload.begin(), payload.end());
+      return valsets.size() == 2 && !accept ? 0 : 1;
+    }));
+    const configure::Result r = run_ublox(f9, true);
+    ASSERT_EQ(valsets.size(), 2U) << steps(r);
+    // version 0, layer RAM, 2 reserved, key 0x10730004 little-endian, value 1 (one byte: L).
+    EXPECT_EQ(valsets[1], (std::vector<std::uint8_t>{0, 1, 0, 0, 0x04, 0x00, 0x73, 0x10, 1})) << steps(r);
+    EXPECT_EQ(r.ok, accept) << steps(r);
+    EXPECT_NE(r.summary.find(accept ? "RTCM3 corrections accepted" : "RTCM3 input refused (ACK-NAK)"),
+              std::string::npos)
+        << r.summary;
+  }
 }
 
 TEST(ReceiverConfig, AnM8GetsCfgRateAndCfgMsgAndMayRefuseHighPrecision) {

@@ -362,7 +362,9 @@ TEST(PoseBuffer, EveryGateNamesItsReason) {
     PoseStatus expected;
   };
   PoseGate rtk;
-  rtk.require_rtk_fixed = true;
+  rtk.require_rtk = RtkSolution::kFixed;
+  PoseGate rtk_any;
+  rtk_any.require_rtk = RtkSolution::kFloat;
   FixQuality two_d = good();
   two_d.fix_type = 2;
   FixQuality time_only = good();
@@ -374,16 +376,26 @@ TEST(PoseBuffer, EveryGateNamesItsReason) {
   FixQuality rtk_float = good();
   rtk_float.rtk_fixed = false;
   rtk_float.rtk_float = true;
+  FixQuality standalone = good();
+  standalone.rtk_fixed = false;
   for (const Case& c :
        {Case{two_d, PoseGate{}, PoseStatus::kFixTypeTooLow}, Case{time_only, PoseGate{}, PoseStatus::kFixTypeTooLow},
         Case{not_ok, PoseGate{}, PoseStatus::kNoGnssFixOk}, Case{coarse, PoseGate{}, PoseStatus::kAccuracyTooLow},
-        Case{rtk_float, rtk, PoseStatus::kNotRtkFixed}, Case{rtk_float, PoseGate{}, PoseStatus::kValid},
-        Case{good(), rtk, PoseStatus::kValid}}) {
+        Case{rtk_float, rtk, PoseStatus::kRtkTooLow}, Case{rtk_float, PoseGate{}, PoseStatus::kValid},
+        Case{rtk_float, rtk_any, PoseStatus::kValid}, Case{good(), rtk, PoseStatus::kValid},
+        Case{standalone, rtk_any, PoseStatus::kRtkTooLow}, Case{standalone, PoseGate{}, PoseStatus::kValid}}) {
     PoseBuffer buf(c.gate, Eigen::Vector3d::Zero());
     ASSERT_TRUE(buf.add_fix(fix(0, 0.0, 0.0, c.quality)));
     ASSERT_TRUE(buf.add_attitude(yaw_at(0, 0.0)));
     EXPECT_EQ(buf.pose_at(0).status, c.expected) << to_string(c.expected);
   }
+  // The withheld sweep's reason names the solution and the requirement.
+  PoseBuffer buf(rtk, Eigen::Vector3d::Zero());
+  ASSERT_TRUE(buf.add_fix(fix(0, 0.0, 0.0, rtk_float)));
+  ASSERT_TRUE(buf.add_attitude(yaw_at(0, 0.0)));
+  const PoseQuery q = buf.pose_at(0);
+  EXPECT_EQ(describe(q.status, q.measured, q.limit, PoseWords{}),
+            "GNSS carrier solution float, fixed required (pose.require_rtk)");
 }
 
 TEST(PoseBuffer, ABadFixAfterAGoodOneInvalidatesTheSpanBetweenThem) {

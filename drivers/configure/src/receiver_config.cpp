@@ -179,6 +179,15 @@ Result configure_ublox(serial::SerialPortSource& port, const UbloxSettings& s) {
   if (valset_answer == "ACK-ACK") {
     r.steps.push_back({"CFG-VALSET (F9): " + what + " on " + port_name(s.port), true, valset_answer});
     r.summary = device + ": u-blox F9 configured: " + what + " on " + port_name(s.port);
+    if (s.rtcm3_input) {
+      // A separate message: a receiver that refuses it still outputs the pose.
+      const std::pair<std::uint32_t, std::uint64_t> item{ublox::rtcm3_input_key(s.port), 1};
+      const std::string answer = ubx_exchange(port, ublox::encode_cfg_valset(std::span(&item, 1)), s.timeout);
+      const bool ok = answer == "ACK-ACK";
+      r.steps.push_back({std::string("CFG-VALSET (F9): RTCM3 input on ") + port_name(s.port), ok, answer});
+      r.summary += ok ? ", RTCM3 corrections accepted"
+                      : "; RTCM3 input refused (" + answer + "): the corrections written will be ignored";
+    }
     return finish(std::move(r), device);
   }
   // An M8 does not know CFG-VALSET: CFG-RATE, then CFG-MSG per message on this port.
@@ -204,6 +213,9 @@ Result configure_ublox(serial::SerialPortSource& port, const UbloxSettings& s) {
     r.steps.push_back({"CFG-MSG (M8): " + name + " every solution", ok, answer});
   }
   r.summary = device + ": u-blox M8 configured: " + what + optional_refused;
+  // An M8P (the M8 that does RTK) accepts RTCM3 on every port by default; CFG-PRT would need
+  // the port's whole setting (baud rate included), so it is left as the receiver has it.
+  if (s.rtcm3_input) r.summary += ", RTCM3 input left as the receiver has it (an M8P accepts it by default)";
   return finish(std::move(r), device);
 }
 

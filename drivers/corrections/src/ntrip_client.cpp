@@ -52,7 +52,7 @@ short NtripClient::events() const noexcept {
 int NtripClient::timeout_ms(std::int64_t now_ns) const noexcept {
   std::int64_t next = now_ns + seconds_ns(1.0);
   if (phase_ == Phase::kIdle) next = std::min(next, reconnect_at_ns_);
-  if (phase_ == Phase::kStreaming && o_.gga_interval_s > 0.0) next = std::min(next, next_gga_ns_);
+  if (phase_ == Phase::kStreaming && !o_.raw_tcp && o_.gga_interval_s > 0.0) next = std::min(next, next_gga_ns_);
   return static_cast<int>(std::max<std::int64_t>(0, (next - now_ns + 999'999) / 1'000'000));
 }
 
@@ -78,11 +78,16 @@ void NtripClient::connect(std::int64_t now_ns) {
     return;
   }
   phase_ = Phase::kConnecting;
-  state_ = "connecting to " + o_.url.redacted();
+  state_ = "connecting to " + name();
   if (c == 0) on_connected(now_ns);
 }
 
 void NtripClient::on_connected(std::int64_t now_ns) {
+  if (o_.raw_tcp) {
+    out_.clear();
+    start_stream("TCP", now_ns);
+    return;
+  }
   phase_ = Phase::kAnswer;
   phase_since_ns_ = now_ns;
   answer_.clear();
@@ -90,21 +95,21 @@ void NtripClient::on_connected(std::int64_t now_ns) {
   unchunked_.clear();
   chunked_ = false;
   const std::string gga = gga_ ? gga_() : std::string();
-  if (!gga.empty()) ++counters_.gga_sent;
+  if (!gga.empty()) ++intake_.counters().gga_sent;
   out_ = ntrip_request(o_.url, o_.user_agent, gga);
-  state_ = "waiting for the caster's answer from " + o_.url.redacted();
+  state_ = "waiting for the caster's answer from " + name();
 }
 
 void NtripClient::fail(const std::string& why, std::int64_t now_ns, bool refused) {
   if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
-  if (phase_ == Phase::kStreaming) ++counters_.disconnects;
-  if (refused) ++counters_.refusals;
+  if (phase_ == Phase::kStreaming) ++intake_.counters().disconnects;
+  if (refused) ++intake_.counters().refusals;
   phase_ = Phase::kIdle;
   out_.clear();
   reconnect_at_ns_ = now_ns + seconds_ns(backoff_s_);
-  state_ = "waiting " + one_decimal(backoff_s_) + " s to reconnect to " + o_.url.redacted() + ": " + why;
-  say(o_.url.redacted() + ": " + why + "; reconnecting in " + one_decimal(backoff_s_) + " s");
+  state_ = "waiting " + one_decimal(backoff_s_) + " s to reconnect to " + name() + ": " + why;
+  say(name() + ": " + why + "; reconnecting in " + one_decimal(backoff_s_) + " s");
   backoff_s_ = std::min(o_.backoff_max_s, backoff_s_ * 2.0);
 }
 
@@ -140,11 +145,11 @@ void NtripClient::service(short revents, std::int64_t now_ns) {
         fail("no data for " + one_decimal(o_.stall_s) + " s (stalled)", now_ns);
         return;
       }
-      if (o_.gga_interval_s > 0.0 && now_ns >= next_gga_ns_) {
+      if (!o_.raw_tcp && o_.gga_interval_s > 0.0 && now_ns >= next_gga_ns_) {
         next_gga_ns_ = now_ns + seconds_ns(o_.gga_interval_s);
         if (const std::string gga = gga_ ? gga_() : std::string(); !gga.empty()) {
           out_ += gga;
-          ++counters_.gga_sent;
+          ++intake_.counters().gga_sent;
         }
       }
       break;
@@ -189,7 +194,7 @@ void NtripClient::read(std::int64_t now_ns) {
         judge_answer(true, now_ns);
         if (fd_ < 0) return;
       }
-      fail("the caster closed the connection", now_ns);
+      fail(o_.raw_tcp ? "the server closed the connection" : "the caster closed the connection", now_ns);
       return;
     }
     if (errno == EINTR) continue;
@@ -220,24 +225,29 @@ void NtripClient::judge_answer(bool closed, std::int64_t now_ns) {
       return;
     }
     case NtripAnswer::Kind::kStream: {
-      phase_ = Phase::kStreaming;
       chunked_ = a.chunked;
-      last_byte_ns_ = now_ns;
-      next_gga_ns_ = now_ns + seconds_ns(o_.gga_interval_s);
-      backoff_s_ = o_.backoff_min_s;
-      ++counters_.connects;
-      // A frame cut by the previous connection's end is not completed by this one's bytes.
-      framer_seen_.checksum_errors += framer_.counters().checksum_errors;
-      framer_seen_.skipped_bytes += framer_.counters().skipped_bytes + framer_.pending_bytes();
-      framer_ = framing::Rtcm3Framer();
-      state_ = "streaming from " + o_.url.redacted();
-      say("connected to " + o_.url.redacted() + " (" + a.status_line + (a.chunked ? ", chunked" : "") + ")");
+      start_stream(a.status_line + (a.chunked ? ", chunked" : ""), now_ns);
       const std::string rest = answer_.substr(a.head_bytes);
       answer_.clear();
       if (!rest.empty()) stream(std::span(reinterpret_cast<const std::uint8_t*>(rest.data()), rest.size()), now_ns);
       return;
     }
   }
+}
+
+void NtripClient::start_stream(const std::string& how, std::int64_t now_ns) {
+  phase_ = Phase::kStreaming;
+  last_byte_ns_ = now_ns;
+  next_gga_ns_ = now_ns + seconds_ns(o_.gga_interval_s);
+  backoff_s_ = o_.backoff_min_s;
+  ++intake_.counters().connects;
+  intake_.restart();  // a frame cut by the previous connection's end is not completed by this one's bytes
+  state_ = "streaming from " + name();
+  say("connected to " + name() + " (" + how + ")");
+}
+
+std::string NtripClient::name() const {
+  return o_.raw_tcp ? "tcp://" + o_.url.host + ":" + std::to_string(o_.url.port) : o_.url.redacted();
 }
 
 void NtripClient::stream(std::span<const std::uint8_t> bytes, std::int64_t now_ns) {
@@ -250,15 +260,10 @@ void NtripClient::stream(std::span<const std::uint8_t> bytes, std::int64_t now_n
     }
     bytes = unchunked_;
   }
-  counters_.bytes += bytes.size();
-  framer_.feed(bytes, [this, now_ns](std::span<const std::uint8_t> frame) {
-    ++counters_.frames;
-    ++counters_.by_message[framing::rtcm3_message_number(frame)];
+  intake_.feed(bytes, [this, now_ns](std::span<const std::uint8_t> frame) {
     last_frame_ns_ = now_ns;
     on_frame_(frame);
   });
-  counters_.crc_errors = framer_seen_.checksum_errors + framer_.counters().checksum_errors;
-  counters_.other_bytes = framer_seen_.skipped_bytes + framer_.counters().skipped_bytes;
 }
 
 }  // namespace trajroi::corrections

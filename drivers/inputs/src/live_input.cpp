@@ -1,5 +1,7 @@
 #include "trajroi/inputs/live_input.hpp"
 
+#include <algorithm>
+
 #include "trajroi/host/clock.hpp"
 
 namespace trajroi::inputs {
@@ -76,6 +78,10 @@ SerialInput::Next SerialInput::next(InputItem& item, std::chrono::milliseconds t
   if (have_pending_) {
     have_pending_ = false;  // the bytes of the read that opened the port, after its notice
   } else {
+    if (before_read_) {
+      before_read_(*port_);
+      timeout = std::min(timeout, std::chrono::milliseconds(20));
+    }
     status = port_->read(pending_, timeout);
     // A device that cannot be opened (missing, not permitted) is said at once, and again
     // whenever the reason changes; the port keeps retrying (a USB receiver may appear later).

@@ -98,6 +98,8 @@ void PoseInput::on_ubx(const ublox::Message& m, std::int64_t receive_ns) {
     return;
   }
   const ublox::NavPvt& pvt = d.value;
+  newest_pvt_ = pvt;
+  ++pvt_count_;
   const bool hp = hp_ && hp_->itow_ms == pvt.itow_ms && !hp_->invalid_llh;
   pose::GnssFix fix;
   fix.quality.fix_type = pvt.fix_type_raw;
@@ -126,7 +128,7 @@ void PoseInput::on_ubx(const ublox::Message& m, std::int64_t receive_ns) {
     if (hp) ++counters_.high_precision;
   }
   fix.t_ns = gnss_clock_.map(std::int64_t{pvt.itow_ms} * 1'000'000, receive_ns) - config_.gnss_delay_ns;
-  if (pvt.utc_valid()) gnss_utc_ = GnssUtc{pvt.utc_ns(), fix.t_ns};
+  if (pvt.utc_valid()) gnss_utc_ = GnssUtc{pvt.utc_ns(), fix.t_ns, pvt.time_accuracy_ns};
   if (buffer_.add_fix(fix)) {
     ++counters_.fixes;
   } else {

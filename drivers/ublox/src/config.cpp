@@ -54,6 +54,12 @@ std::uint32_t msgout_key(PoseMessage message, Port port) noexcept {
   return i2c + static_cast<std::uint32_t>(port);
 }
 
+std::uint32_t rtcm3_input_key(Port port) noexcept {
+  // One group per port, two apart (INPROT, OUTPROT): I2C 0x1071…, UART1 0x1073…, UART2
+  // 0x1075…, USB 0x1077…, SPI 0x1079…; item 4 is RTCM3X.
+  return 0x10710004U + (static_cast<std::uint32_t>(port) << 17);
+}
+
 std::vector<std::uint8_t> encode_cfg_valset(std::span<const std::pair<std::uint32_t, std::uint64_t>> items,
                                             std::uint8_t layers) {
   if (items.size() > 64) throw std::invalid_argument("CFG-VALSET: more than 64 keys in one message");

@@ -7,6 +7,18 @@
 
 namespace trajroi::pose {
 
+std::string_view to_string(RtkSolution s) noexcept {
+  switch (s) {
+    case RtkSolution::kNone:
+      return "none";
+    case RtkSolution::kFloat:
+      return "float";
+    case RtkSolution::kFixed:
+      return "fixed";
+  }
+  return "unknown";
+}
+
 std::string_view to_string(PoseStatus status) noexcept {
   switch (status) {
     case PoseStatus::kValid:
@@ -31,8 +43,8 @@ std::string_view to_string(PoseStatus status) noexcept {
       return "GNSS fix not flagged gnssFixOK";
     case PoseStatus::kAccuracyTooLow:
       return "GNSS horizontal accuracy worse than the gate";
-    case PoseStatus::kNotRtkFixed:
-      return "GNSS carrier solution not fixed (RTK fixed required)";
+    case PoseStatus::kRtkTooLow:
+      return "GNSS carrier solution worse than the gate";
   }
   return "unknown";
 }
@@ -54,8 +66,12 @@ std::string describe(PoseStatus status, double measured, double limit, const Pos
       return say("GNSS fix type %.0f < minimum %.0f (pose.min_fix_type)", measured, limit);
     case PoseStatus::kNoGnssFixOk:
       return "GNSS fix not flagged gnssFixOK (pose.require_gnss_fix_ok)";
-    case PoseStatus::kNotRtkFixed:
-      return "GNSS carrier solution not fixed (pose.require_rtk_fixed)";
+    case PoseStatus::kRtkTooLow: {
+      const auto word = [](double v) { return to_string(static_cast<RtkSolution>(static_cast<int>(v))); };
+      const std::string_view got = word(measured), need = word(limit);
+      return say("GNSS carrier solution %.*s, %.*s required (pose.require_rtk)", static_cast<int>(got.size()),
+                 got.data(), static_cast<int>(need.size()), need.data());
+    }
     case PoseStatus::kAccuracyTooLow:
       return say("GNSS horizontal accuracy %.2f m > limit %.2f m (pose.max_h_acc_m)", measured, limit);
     case PoseStatus::kGnssTooOld:
@@ -182,7 +198,9 @@ PoseStatus PoseBuffer::check(const FixQuality& q, PoseQuery& out) const noexcept
   }
   if (gate_.require_gnss_fix_ok && !q.gnss_fix_ok) return PoseStatus::kNoGnssFixOk;
   if (!(q.h_acc_m <= gate_.max_h_acc_m)) return fail(PoseStatus::kAccuracyTooLow, q.h_acc_m, gate_.max_h_acc_m);
-  if (gate_.require_rtk_fixed && !q.rtk_fixed) return PoseStatus::kNotRtkFixed;
+  if (q.rtk() < gate_.require_rtk) {
+    return fail(PoseStatus::kRtkTooLow, static_cast<double>(q.rtk()), static_cast<double>(gate_.require_rtk));
+  }
   return PoseStatus::kValid;
 }
 

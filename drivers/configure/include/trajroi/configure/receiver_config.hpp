@@ -37,6 +37,7 @@ struct UbloxSettings {
   ublox::Port port = ublox::Port::kUsb;  // the receiver's port the device is (F9 keys only)
   bool high_precision = true;            // NAV-HPPOSLLH too (optional: a NAK is a warning)
   bool relposned = false;                // NAV-RELPOSNED (pose.source gnss, moving base)
+  bool rtcm3_input = false;              // the port accepts RTCM3 corrections (gnss.corrections)
   std::chrono::milliseconds timeout{1000};
 };
 // The port a device path most likely is: ttyACM (CDC-ACM: the receiver's own USB) → USB, else

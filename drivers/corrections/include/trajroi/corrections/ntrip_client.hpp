@@ -9,16 +9,16 @@
 // "refused by the caster: HTTP/1.0 401 Unauthorized", "mountpoint X is not on the caster; it
 // has: A, B", "caster closed the connection", "no data for 10.0 s"). Resolving the caster's
 // name (getaddrinfo) may block the calling thread for the resolver's timeout: run the client
-// on a thread of its own, never one of the pipeline's.
+// on a thread of its own, never one of the pipeline's. With `raw_tcp` the same client reads a
+// plain TCP stream of RTCM3 (tcp://host:port: no request, no answer).
 #include <cstdint>
 #include <functional>
-#include <map>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "trajroi/corrections/correction_source.hpp"
 #include "trajroi/corrections/ntrip.hpp"
-#include "trajroi/framing/rtcm3.hpp"
 
 namespace trajroi::corrections {
 
@@ -29,45 +29,27 @@ struct NtripClientOptions {
   double stall_s = 10.0;         // no byte for this long while streaming: reconnect
   double backoff_min_s = 1.0, backoff_max_s = 30.0;
   double connect_timeout_s = 10.0;
+  bool raw_tcp = false;  // a plain TCP stream of RTCM3: no NTRIP request, no answer, no GGA
 };
 
-struct CorrectionCounters {
-  std::uint64_t bytes = 0;        // stream bytes received (after the answer, unchunked)
-  std::uint64_t frames = 0;       // whole CRC-correct RTCM3 frames handed on
-  std::uint64_t crc_errors = 0;   // frame candidates whose CRC-24Q failed
-  std::uint64_t other_bytes = 0;  // bytes in no frame (not RTCM3)
-  std::uint64_t connects = 0;     // streams started
-  std::uint64_t disconnects = 0;  // streams lost (closed, reset, stalled, garbage)
-  std::uint64_t refusals = 0;     // answers other than a stream
-  std::uint64_t gga_sent = 0;
-  std::map<std::uint16_t, std::uint64_t> by_message;  // frames by RTCM message number
-};
 
-class NtripClient {
+class NtripClient final : public CorrectionSource {
  public:
-  using FrameSink = std::function<void(std::span<const std::uint8_t> frame)>;
   using GgaSource = std::function<std::string()>;  // the rover's GGA sentence, "" when no fix yet
-  using EventSink = std::function<void(const std::string& text)>;
 
   NtripClient(NtripClientOptions options, FrameSink on_frame, GgaSource gga, EventSink on_event);
-  ~NtripClient();
+  ~NtripClient() override;
   NtripClient(const NtripClient&) = delete;
   NtripClient& operator=(const NtripClient&) = delete;
 
-  // For poll(): the socket (−1 while waiting to reconnect) and what to wait for.
-  [[nodiscard]] int fd() const noexcept { return fd_; }
-  [[nodiscard]] short events() const noexcept;
-  // Milliseconds until the next thing to do without the socket (reconnect, GGA, stall check).
-  [[nodiscard]] int timeout_ms(std::int64_t now_ns) const noexcept;
-  // After poll() (revents 0 on a timeout), with CLOCK_MONOTONIC now.
-  void service(short revents, std::int64_t now_ns);
-
-  [[nodiscard]] const CorrectionCounters& counters() const noexcept { return counters_; }
-  // "streaming from ntrip://…", "connecting to …", "waiting 4 s to reconnect: <why>".
-  [[nodiscard]] const std::string& state() const noexcept { return state_; }
-  [[nodiscard]] bool streaming() const noexcept { return phase_ == Phase::kStreaming; }
-  // CLOCK_MONOTONIC of the newest frame (0: none yet).
-  [[nodiscard]] std::int64_t last_frame_ns() const noexcept { return last_frame_ns_; }
+  [[nodiscard]] int fd() const noexcept override { return fd_; }
+  [[nodiscard]] short events() const noexcept override;
+  [[nodiscard]] int timeout_ms(std::int64_t now_ns) const noexcept override;
+  void service(short revents, std::int64_t now_ns) override;
+  [[nodiscard]] const CorrectionCounters& counters() const noexcept override { return intake_.counters(); }
+  [[nodiscard]] const std::string& state() const noexcept override { return state_; }
+  [[nodiscard]] bool streaming() const noexcept override { return phase_ == Phase::kStreaming; }
+  [[nodiscard]] std::int64_t last_frame_ns() const noexcept override { return last_frame_ns_; }
 
  private:
   enum class Phase : std::uint8_t { kIdle, kConnecting, kAnswer, kStreaming };
@@ -76,6 +58,8 @@ class NtripClient {
   void on_connected(std::int64_t now_ns);
   void read(std::int64_t now_ns);
   void judge_answer(bool closed, std::int64_t now_ns);
+  void start_stream(const std::string& how, std::int64_t now_ns);
+  [[nodiscard]] std::string name() const;
   void stream(std::span<const std::uint8_t> bytes, std::int64_t now_ns);
   void send(const std::string& bytes, std::int64_t now_ns);
   void say(const std::string& text);
@@ -92,11 +76,9 @@ class NtripClient {
   bool chunked_ = false;
   ChunkedDecoder chunks_;
   std::vector<std::uint8_t> unchunked_;
-  framing::Rtcm3Framer framer_;
-  framing::FramerCounters framer_seen_{};  // the framers of earlier connections
+  Rtcm3Intake intake_;
   std::int64_t reconnect_at_ns_ = 0, phase_since_ns_ = 0, last_byte_ns_ = 0, last_frame_ns_ = 0, next_gga_ns_ = 0;
   double backoff_s_;
-  CorrectionCounters counters_;
 };
 
 }  // namespace trajroi::corrections

@@ -43,6 +43,11 @@ class SerialInput final : public InputSource {
   // open's. The bytes read with the opening are dropped (the hook reads the port).
   using OnOpen = std::function<Notice(serial::SerialPortSource&)>;
   void on_open(OnOpen hook) { on_open_ = std::move(hook); }
+  // Run before each read, on this input's thread, while the port is open or not (RTK
+  // corrections written whole between reads, never inside the configuration on_open writes).
+  // With it, a read waits at most 20 ms, so that what it writes waits no longer.
+  using BeforeRead = std::function<void(serial::SerialPortSource&)>;
+  void before_read(BeforeRead hook) { before_read_ = std::move(hook); }
   ~SerialInput() override;
 
   Next next(InputItem& item, std::chrono::milliseconds timeout) override;
@@ -61,6 +66,7 @@ class SerialInput final : public InputSource {
   bool have_pending_ = false;   // read with the port's opening, handed out after the notice
   Notice notice_;
   OnOpen on_open_;
+  BeforeRead before_read_;
 };
 
 }  // namespace trajroi::inputs

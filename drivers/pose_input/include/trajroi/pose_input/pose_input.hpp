@@ -129,8 +129,13 @@ class PoseInput {
   struct GnssUtc {
     std::int64_t utc_ns = 0;
     std::int64_t host_ns = 0;
+    std::uint32_t accuracy_ns = 0;  // NAV-PVT tAcc
   };
   [[nodiscard]] const std::optional<GnssUtc>& gnss_utc() const noexcept { return gnss_utc_; }
+  // The newest NAV-PVT decoded (the rover's position for a VRS caster's GGA, the carrier
+  // solution for the status) and how many have been (a change means a new one).
+  [[nodiscard]] const std::optional<ublox::NavPvt>& newest_pvt() const noexcept { return newest_pvt_; }
+  [[nodiscard]] std::uint64_t pvt_count() const noexcept { return pvt_count_; }
 
  private:
   void gnss_heading(const ublox::NavPvt& pvt, std::int64_t t_ns);
@@ -152,6 +157,8 @@ class PoseInput {
   std::optional<double> heading_yaw_rad_;  // the last GNSS (or configured) heading, global yaw
   HeadingSource heading_source_ = HeadingSource::kNone;
   std::optional<GnssUtc> gnss_utc_;
+  std::optional<ublox::NavPvt> newest_pvt_;
+  std::uint64_t pvt_count_ = 0;
   std::optional<pose::Geodetic> last_position_;
   std::optional<Eigen::Vector3d> last_global_;  // last_position_ in the global frame
   PoseInputCounters counters_;

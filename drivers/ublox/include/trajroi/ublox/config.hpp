@@ -24,6 +24,9 @@ enum class PoseMessage : std::uint8_t { kNavPvt, kNavHpposllh, kNavRelposned, kN
 
 // CFG-MSGOUT-UBX_NAV_* key of `message` on `port` (u-blox F9 configuration interface).
 [[nodiscard]] std::uint32_t msgout_key(PoseMessage message, Port port) noexcept;
+// CFG-<port>INPROT-RTCM3X (L): the port accepts RTCM3 corrections (F9 interface description,
+// CFG-I2CINPROT … CFG-SPIINPROT groups: 0x10710004, 0x10730004, 0x10750004, 0x10770004, 0x10790004).
+[[nodiscard]] std::uint32_t rtcm3_input_key(Port port) noexcept;
 inline constexpr std::uint32_t kKeyRateMeas = 0x30210001;  // U2, ms between measurements
 inline constexpr std::uint32_t kKeyRateNav = 0x30210002;   // U2, measurements per solution
 

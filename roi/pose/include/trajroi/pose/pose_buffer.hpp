@@ -21,6 +21,10 @@
 
 namespace trajroi::pose {
 
+// The carrier-phase (RTK) solution of a fix, worst to best (NAV-PVT carrSoln).
+enum class RtkSolution : std::uint8_t { kNone, kFloat, kFixed };
+[[nodiscard]] std::string_view to_string(RtkSolution s) noexcept;  // "none", "float", "fixed"
+
 // Quality of a GNSS fix, as the receiver reported it (u-blox NAV-PVT semantics).
 struct FixQuality {
   std::uint8_t fix_type = 0;  // 0 none, 1 DR, 2 2-D, 3 3-D, 4 GNSS+DR, 5 time only
@@ -28,6 +32,9 @@ struct FixQuality {
   double h_acc_m = 1e9;
   bool rtk_fixed = false;  // carrier solution fixed
   bool rtk_float = false;
+  [[nodiscard]] RtkSolution rtk() const noexcept {
+    return rtk_fixed ? RtkSolution::kFixed : rtk_float ? RtkSolution::kFloat : RtkSolution::kNone;
+  }
 };
 
 struct GnssFix {
@@ -45,7 +52,7 @@ struct PoseGate {
   std::uint8_t min_fix_type = 3;  // 3-D (4 = GNSS + dead reckoning also passes)
   bool require_gnss_fix_ok = true;
   double max_h_acc_m = 0.5;
-  bool require_rtk_fixed = false;
+  RtkSolution require_rtk = RtkSolution::kNone;  // at least this carrier solution
   std::int64_t max_extrapolation_ns = 100'000'000;  // past the newest sample of each stream
   std::int64_t max_gap_ns = 1'000'000'000;          // between the two samples bracketing t
 };
@@ -62,7 +69,7 @@ enum class PoseStatus : std::uint8_t {
   kFixTypeTooLow,  // a fix used fails the gate …
   kNoGnssFixOk,
   kAccuracyTooLow,
-  kNotRtkFixed,
+  kRtkTooLow,  // carrier solution worse than require_rtk (measured / limit: RtkSolution)
 };
 [[nodiscard]] std::string_view to_string(PoseStatus status) noexcept;
 
