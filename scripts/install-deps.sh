@@ -26,8 +26,9 @@ packages=(
   pcl-tools python3-open3d
   # trajroi view: three.js for its page; the browser tests' headless chromium and its driver
   libjs-three chromium chromium-driver
-  # the NTRIP client's tests: RTKLIB's str2str as a real caster
-  rtklib
+  # the corrections tests: RTKLIB's str2str as a real NTRIP caster and TCP server, socat as
+  # a UDP sender (str2str 2.4.3 b34 has no UDP output); chronyd reads trajroid's SHM refclock
+  rtklib socat chrony
   # the LAS export test: PROJ (python3-pyproj) places the expected points (node runs copc.js: below)
   python3-pyproj
 )

@@ -73,17 +73,15 @@ void CorrectionsLink::open() {
       o.user_agent = "NTRIP trajroi/" + std::string(TRAJROI_VERSION_TEXT);
       source_ = std::make_unique<corrections::NtripClient>(
           o, on_frame,
-          [this]() -> std::string { return newest_rover_ ? corrections::gga_sentence(*newest_rover_) : ""; },
-          on_event);
+          [this]() -> std::string { return newest_rover_ ? corrections::gga_sentence(*newest_rover_) : ""; }, on_event);
       break;
     }
     case Kind::kUdp:
-      source_ = std::make_unique<corrections::UdpCorrections>(url_.bind_address, url_.port, c.stall_s, on_frame,
-                                                              on_event);
+      source_ =
+          std::make_unique<corrections::UdpCorrections>(url_.bind_address, url_.port, c.stall_s, on_frame, on_event);
       break;
     case Kind::kSerial:
-      source_ = std::make_unique<corrections::SerialCorrections>(url_.device, url_.baud, c.stall_s, on_frame,
-                                                                 on_event);
+      source_ = std::make_unique<corrections::SerialCorrections>(url_.device, url_.baud, c.stall_s, on_frame, on_event);
       break;
     case Kind::kLcm:
       source_ = std::make_unique<LcmCorrections>(lcm_url_, url_.channel, c.stall_s, on_frame, on_event);

@@ -23,9 +23,7 @@ class LcmCorrections final : public corrections::CorrectionSource {
   [[nodiscard]] short events() const noexcept override;
   [[nodiscard]] int timeout_ms(std::int64_t now_ns) const noexcept override;
   void service(short revents, std::int64_t now_ns) override;
-  [[nodiscard]] const corrections::CorrectionCounters& counters() const noexcept override {
-    return intake_.counters();
-  }
+  [[nodiscard]] const corrections::CorrectionCounters& counters() const noexcept override { return intake_.counters(); }
   [[nodiscard]] const std::string& state() const noexcept override { return state_; }
   [[nodiscard]] bool streaming() const noexcept override { return streaming_; }
   [[nodiscard]] std::int64_t last_frame_ns() const noexcept override { return last_frame_ns_; }

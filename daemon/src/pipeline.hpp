@@ -178,7 +178,7 @@ struct Pipeline {
   std::string record_dir;                   // its folder (set before the threads start)
   // gnss.corrections on a live GNSS port (set before the threads start; else null).
   std::unique_ptr<CorrectionsLink> corrections;
-  std::atomic<bool> record_failed{false};   // the recorder stopped on an error (logged)
+  std::atomic<bool> record_failed{false};  // the recorder stopped on an error (logged)
   std::atomic<bool> processing_done{false}, publishing_done{false};
   // The processing thread is about to wait for input, or waits: an as-fast-as-possible
   // replay's reader then wakes it at once instead of at the end of its batch.

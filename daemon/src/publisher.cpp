@@ -3,6 +3,7 @@
 #include <poll.h>
 #include <systemd/sd-daemon.h>
 
+#include <cmath>
 #include <limits>
 
 #include "realtime.hpp"
@@ -23,6 +24,7 @@ Publisher::Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, boo
       trajectories_(pipeline, reloader, trajectory),
       latency_(pipeline.config.logging.warning_interval_s, !pipeline.exact),
       health_(pipeline.config, !replay, start_steady_ns_),
+      corrections_(pipeline.config, pipeline.corrections.get(), !replay),
       sweep_warnings_(pipeline.config.logging.warning_interval_s) {
   // Here, before the loops start: subscribing opens the receive socket (through liblcm, its
   // self test can take seconds), which must not hold up the publishing loop. For udpm://, the
@@ -78,7 +80,7 @@ void Publisher::publish_sweep(const pipeline::Sweep& s) {
 
 void Publisher::publish_status(const StatusSnapshot& s) {
   // Faults said when they start and end; the state in words for systemd and the message.
-  const std::vector<HealthLine> lines = health_.update(s);
+  std::vector<HealthLine> lines = health_.update(s);
   const bool gnss = pipeline::uses_gnss(config_.pose_source);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   trajroi::status_t m;
@@ -106,6 +108,9 @@ void Publisher::publish_status(const StatusSnapshot& s) {
   m.h_acc_m = gnss && s.pose_age_s >= 0.0 ? s.h_acc_m : nan;
   m.recording = pipeline_.record_dir;
   m.host_minus_gnss_utc_s = s.host_minus_gnss_utc_s;
+  m.gnss_time_accuracy_s = s.gnss_time_accuracy_s;
+  m.host_minus_lidar_utc_s = s.host_minus_lidar_utc_s;
+  m.rtk_solution = gnss ? s.rtk : std::int8_t{-1};
   m.lidar_pps_status = s.lidar_pps_status;
   m.lidar_gprmc_valid = s.lidar_gprmc_valid;
   m.processing_ms_p50 = latency_.window_processing_ms(0.50);
@@ -120,6 +125,10 @@ void Publisher::publish_status(const StatusSnapshot& s) {
     add(std::string(counter_name(i)), s.counters[i]);
   trajectories_.add_counters(add);
   add("sweeps.late", latency_.late_sweeps());
+  const CorrectionsFigures corrections = corrections_.update(s, host::monotonic_ns(), add, lines);
+  m.corrections = corrections.text;
+  m.correction_age_s = corrections.age_s;
+  m.corrections_bytes_per_s = corrections.bytes_per_s;
   m.num_counters = static_cast<std::int32_t>(m.counter_names.size());
   sender_.send(config_.lcm.status, m);
   // Once a second too, for a viewer that starts later.
@@ -129,10 +138,10 @@ void Publisher::publish_status(const StatusSnapshot& s) {
       m.points_in > 0 ? 100.0 * static_cast<double>(m.points_kept) / static_cast<double>(m.points_in) : 0.0;
   log::info(
       "status: {} | sweeps {} published {} withheld {} | points in {} kept {} ({:.1f} %) | latency p50 {:.2f} p99 "
-      "{:.2f} ms | drops {} | lost packets {} | {} | trajectory {}{}",
+      "{:.2f} ms | drops {} | lost packets {} | {}{} | trajectory {}{}",
       m.state, m.sweeps, m.sweeps_published, m.sweeps_without_pose, m.points_in, m.points_kept, kept_pct,
-      m.latency_ms_p50, m.latency_ms_p99, m.ring_drops, m.lost_packets, pose_inputs_text(s, config_), m.trajectory_id,
-      recording_text());
+      m.latency_ms_p50, m.latency_ms_p99, m.ring_drops, m.lost_packets, pose_inputs_text(s, config_), rtk_text(m),
+      m.trajectory_id, recording_text());
   for (const HealthLine& line : lines) {
     if (line.level == HealthLine::Level::kWarning) {
       log::warn("{}", line.text);
@@ -145,6 +154,18 @@ void Publisher::publish_status(const StatusSnapshot& s) {
   latency_.end_window();
   last_status_ = s;
   minute_.on_status(s, latency_);
+}
+
+std::string Publisher::rtk_text(const trajroi::status_t& m) const {
+  std::string text;
+  if (m.rtk_solution >= 0 && (m.rtk_solution > 0 || !m.corrections.empty()))
+    text += std::string(", RTK ") + std::string(pose::to_string(static_cast<pose::RtkSolution>(m.rtk_solution)));
+  if (!m.corrections.empty()) {
+    text += " | corrections: " + m.corrections;
+    if (std::isfinite(m.correction_age_s)) text += fmt::format(", age {:.1f} s", m.correction_age_s);
+    if (std::isfinite(m.corrections_bytes_per_s)) text += fmt::format(", {:.0f} B/s", m.corrections_bytes_per_s);
+  }
+  return text;
 }
 
 std::string Publisher::recording_text() const {

@@ -7,6 +7,7 @@
 // systemd's STATUS=), MinuteLine (the minute's line); this class runs the loop and wires them.
 #include <cstdint>
 
+#include "corrections_watch.hpp"
 #include "health.hpp"
 #include "latency_book.hpp"
 #include "log.hpp"
@@ -18,6 +19,7 @@
 #include "status.hpp"
 #include "trajectory_intake.hpp"
 #include "trajroi/daemon/latency_histogram.hpp"
+#include "trajroi/status_t.hpp"
 
 namespace trajroi::daemon {
 
@@ -40,6 +42,8 @@ class Publisher {
   void publish_status(const StatusSnapshot& s);
   // " | recording into DIR", or "" when not recording.
   [[nodiscard]] std::string recording_text() const;
+  // ", RTK fixed | corrections: streaming from …, age 0.4 s, 530 B/s" ("" without either).
+  [[nodiscard]] std::string rtk_text(const trajroi::status_t& m) const;
 
   Pipeline& pipeline_;
   Outlet& outlet_;
@@ -50,6 +54,7 @@ class Publisher {
   TrajectoryIntake trajectories_;
   LatencyBook latency_;
   HealthMonitor health_;
+  CorrectionsWatch corrections_;
   MinuteLine minute_;
   StatusSnapshot last_status_;
   log::ReasonLimiter sweep_warnings_;  // withheld sweeps, by reason

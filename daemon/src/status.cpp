@@ -84,6 +84,15 @@ void fill_snapshot(const pipeline::SweepProcessor& p, const Pipeline& pipeline, 
   s.h_acc_m = fix != nullptr ? fix->quality.h_acc_m : 0.0;
   s.trajectory_distance_m = p.trajectory_distance_m();
   s.host_minus_gnss_utc_s = p.host_minus_gnss_utc_s();
+  s.gnss_time_accuracy_s = p.gnss_time_accuracy_s();
+  s.host_minus_lidar_utc_s = p.host_minus_lidar_utc_s();
+  if (const auto& pvt = p.pose_input().newest_pvt()) {
+    s.rtk = static_cast<std::int8_t>(pvt->carr_soln == ublox::CarrierSolution::kFixed   ? pose::RtkSolution::kFixed
+                                     : pvt->carr_soln == ublox::CarrierSolution::kFloat ? pose::RtkSolution::kFloat
+                                                                                        : pose::RtkSolution::kNone);
+  } else {
+    s.rtk = -1;
+  }
   const auto& position = p.lidar_position();
   s.lidar_pps_status = position ? static_cast<std::int8_t>(position->pps) : std::int8_t{-1};
   s.lidar_gprmc_valid = !position || position->nmea != vlp16::NmeaError::kNone ? std::int8_t{-1}

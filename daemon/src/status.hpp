@@ -112,6 +112,7 @@ struct StatusSnapshot {
   double attitude_age_s = -1.0;  // newest input − newest attitude (−1: none)
   std::uint8_t fix_type = 0;
   double h_acc_m = 0.0;
+  std::int8_t rtk = -1;  // newest NAV-PVT's carrier solution (pose::RtkSolution), -1: none yet
   std::string_view heading_source = "none";
   std::uint8_t closed_streams = 0;  // bit 1 << inputs::Stream: a serial device not open now
   // The LiDAR data port's datagrams that are not VLP-16 packets: sizes and first senders.
@@ -122,9 +123,11 @@ struct StatusSnapshot {
   // For the fault lines (health.hpp): the robot's distance to the active trajectory at the
   // last sweep with a pose (NaN before), and the model check's last rejection ("" if none).
   double trajectory_distance_m = 0.0;
-  double host_minus_gnss_utc_s = 0.0;  // NaN: unknown
-  std::int8_t lidar_pps_status = -1;   // vlp16::PpsStatus of the newest position packet, -1: none
-  std::int8_t lidar_gprmc_valid = -1;  // its RMC: 1 valid, 0 not, -1 none
+  double host_minus_gnss_utc_s = 0.0;   // NaN: unknown
+  double gnss_time_accuracy_s = 0.0;    // its NAV-PVT tAcc (NaN: unknown)
+  double host_minus_lidar_utc_s = 0.0;  // host UTC − the VLP-16's PPS-locked UTC (NaN: unknown)
+  std::int8_t lidar_pps_status = -1;    // vlp16::PpsStatus of the newest position packet, -1: none
+  std::int8_t lidar_gprmc_valid = -1;   // its RMC: 1 valid, 0 not, -1 none
   std::array<char, 160> model_reason{};
   std::array<std::uint64_t, kCounterCount> counters{};
 

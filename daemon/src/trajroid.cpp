@@ -100,8 +100,8 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
     auto input = std::make_unique<inputs::SerialInput>(name, stream, o);
     if (s.configure) input->on_open(receiver_configuration(config, stream));
     if (stream == inputs::Stream::kGnss && !config.gnss_corrections.url.empty()) {
-      pipeline.corrections = std::make_unique<CorrectionsLink>(config, options.lcm_url.empty() ? config.lcm.url
-                                                                                               : options.lcm_url);
+      pipeline.corrections =
+          std::make_unique<CorrectionsLink>(config, options.lcm_url.empty() ? config.lcm.url : options.lcm_url);
       pipeline.corrections->open();  // a UDP port or LCM that cannot be opened: named, exit 1
       CorrectionsLink* link = pipeline.corrections.get();
       input->before_read([link](serial::SerialPortSource& port) { link->write_waiting(port); });
@@ -114,9 +114,10 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
     add_serial(config.gnss, "gnss", inputs::Stream::kGnss, config.realtime.gnss);
   }
   if (!config.gnss_corrections.url.empty() && !pipeline.corrections) {
-    log::warn("gnss.corrections.url is set but trajroid reads no GNSS port (pose.source {}, gnss.device \"{}\"): "
-              "no corrections are taken",
-              to_string(config.pose_source), config.gnss.device);
+    log::warn(
+        "gnss.corrections.url is set but trajroid reads no GNSS port (pose.source {}, gnss.device \"{}\"): "
+        "no corrections are taken",
+        to_string(config.pose_source), config.gnss.device);
   }
   if (config.pose_source == PoseSource::kGnssImu)
     add_serial(config.imu, "imu", inputs::Stream::kImu, config.realtime.imu);

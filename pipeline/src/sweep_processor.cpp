@@ -127,6 +127,11 @@ double SweepProcessor::host_minus_gnss_utc_s() const noexcept {
   return static_cast<double>(gnss->host_ns + *host_utc_offset_ns_ - gnss->utc_ns) * 1e-9;
 }
 
+double SweepProcessor::gnss_time_accuracy_s() const noexcept {
+  const auto& gnss = pose_input_.gnss_utc();
+  return gnss ? static_cast<double>(gnss->accuracy_ns) * 1e-9 : std::numeric_limits<double>::quiet_NaN();
+}
+
 void SweepProcessor::pose_message(std::span<const std::uint8_t> bytes) {
   trajroi::pose_input_t m;
   if (bytes.size() < 8 ||
@@ -190,6 +195,10 @@ void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
   if (frame.start_utc_ns) {
     s.start_utc_ns = *frame.start_utc_ns;
     s.time_source = "vlp16_pps";
+    if (host_utc_offset_ns_) {
+      host_minus_lidar_utc_s_ =
+          static_cast<double>(frame.start_time_ns + *host_utc_offset_ns_ - *frame.start_utc_ns) * 1e-9;
+    }
   } else if (host_utc_offset_ns_) {
     s.start_utc_ns = frame.start_time_ns + *host_utc_offset_ns_;
     s.time_source = "host";

@@ -21,94 +21,14 @@
 #include <string>
 #include <vector>
 
+#include "stream_peers.hpp"
 #include "test_data.hpp"
 #include "trajroi/corrections/ntrip_client.hpp"
 
 namespace trajroi::corrections {
 namespace {
 
-using Bytes = std::vector<std::uint8_t>;
-
-std::int64_t now_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
-bool have_str2str() {
-  return std::system("command -v str2str >/dev/null 2>&1") == 0;
-}
-
-std::uint16_t free_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  (void)::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  socklen_t len = sizeof a;
-  (void)::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
-
-// str2str as an NTRIP caster (mountpoint F9T, user rover:s3cret) fed from its TCP server.
-class Caster {
- public:
-  Caster(std::uint16_t input_port, std::uint16_t caster_port) : input_(input_port), caster_(caster_port) { start(); }
-  ~Caster() { stop(); }
-  void start() {
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      const std::string in = "tcpsvr://:" + std::to_string(input_);
-      const std::string out = "ntripc://rover:s3cret@:" + std::to_string(caster_) + "/F9T";
-      if (::freopen("/dev/null", "w", stderr) == nullptr) ::_exit(126);
-      if (::freopen("/dev/null", "w", stdout) == nullptr) ::_exit(126);
-      ::execlp("str2str", "str2str", "-in", in.c_str(), "-out", out.c_str(), static_cast<char*>(nullptr));
-      ::_exit(127);
-    }
-  }
-  void stop() {
-    if (pid_ <= 0) return;
-    ::kill(pid_, SIGTERM);
-    int status = 0;
-    ::waitpid(pid_, &status, 0);
-    pid_ = -1;
-  }
-  // Connects to the caster's input and writes `bytes` (retrying while str2str starts).
-  void write(const Bytes& bytes) {
-    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while (std::chrono::steady_clock::now() < until) {
-      const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-      sockaddr_in a{};
-      a.sin_family = AF_INET;
-      a.sin_port = htons(input_);
-      a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-      if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0) {
-        // str2str reads its input in pieces; a little at a time, as a base station sends.
-        for (std::size_t at = 0; at < bytes.size(); at += 512) {
-          const std::size_t n = std::min<std::size_t>(512, bytes.size() - at);
-          (void)::send(fd, bytes.data() + at, n, MSG_NOSIGNAL);
-          ::usleep(2000);
-        }
-        input_fds_.push_back(fd);
-        return;
-      }
-      ::close(fd);
-      ::usleep(100'000);
-    }
-    FAIL() << "str2str's input never accepted a connection";
-  }
-  void close_inputs() {
-    for (const int fd : input_fds_)
-      ::close(fd);
-    input_fds_.clear();
-  }
-
- private:
-  std::uint16_t input_, caster_;
-  pid_t pid_ = -1;
-  std::vector<int> input_fds_;
-};
+using namespace corrections_test;
 
 // Runs the client's loop until `done` or `seconds`.
 bool run_until(NtripClient& client, const std::function<bool()>& done, double seconds) {
@@ -151,43 +71,8 @@ NtripClient make_client(const std::string& url, Received& r) {
       [&r](const std::string& e) { r.events.push_back(e); });
 }
 
-// The log's RTCM3 frames (the rtcm3 test checks them against gpsd's decoding).
-std::vector<Bytes> log_frames(const std::string& bytes) {
-  std::vector<Bytes> out;
-  framing::Rtcm3Framer framer;
-  framer.feed(std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()),
-              [&out](std::span<const std::uint8_t> f) { out.emplace_back(f.begin(), f.end()); });
-  return out;
-}
-
-// Frames [from, to) with line noise between them and, before every 7th, a copy with one bit
-// flipped (a CRC failure the client must not hand on).
-Bytes with_noise(const std::vector<Bytes>& frames, std::size_t from, std::size_t to, std::size_t& corrupted) {
-  Bytes out;
-  std::mt19937 random(static_cast<unsigned>(from));
-  for (std::size_t i = from; i < to; ++i) {
-    for (int k = 0; k < 20; ++k)
-      out.push_back(static_cast<std::uint8_t>(random() % 0xD0));  // never a 0xD3 preamble
-    if (i % 7 == 0) {
-      Bytes bad = frames[i];
-      bad[bad.size() / 2] ^= 0x10;
-      out.insert(out.end(), bad.begin(), bad.end());
-      ++corrupted;
-    }
-    out.insert(out.end(), frames[i].begin(), frames[i].end());
-  }
-  return out;
-}
-
-#define REQUIRE_STR2STR()                                                                                 \
-  if (!have_str2str()) {                                                                                  \
-    const char* ci = std::getenv("CI");                                                                   \
-    if (ci != nullptr && std::string(ci) == "true") FAIL() << "str2str (Debian rtklib) missing under CI"; \
-    GTEST_SKIP() << "str2str not installed (Debian rtklib; scripts/install-deps.sh installs it)";         \
-  }
-
 TEST(NtripClientLive, HandsOnExactlyTheValidFramesAcrossACasterRestart) {
-  REQUIRE_STR2STR();
+  REQUIRE_STREAM_PEERS();
   TRAJROI_REQUIRE_DATA(path, "ublox/gpsd/ublox-zed-f9t-rtcm3.log");
   const std::vector<Bytes> frames = log_frames(test::read_file(path));
   ASSERT_EQ(frames.size(), 182U);
@@ -237,7 +122,7 @@ TEST(NtripClientLive, HandsOnExactlyTheValidFramesAcrossACasterRestart) {
 }
 
 TEST(NtripClientLive, RefusalsAreNamedWithTheCastersAnswer) {
-  REQUIRE_STR2STR();
+  REQUIRE_STREAM_PEERS();
   const std::uint16_t input = free_port(), port = free_port();
   Caster caster(input, port);
   Received wrong_password;

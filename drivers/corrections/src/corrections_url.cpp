@@ -39,8 +39,7 @@ std::string CorrectionsUrl::redacted() const {
 CorrectionsUrl parse_corrections_url(std::string_view url) {
   CorrectionsUrl u;
   const std::size_t scheme_end = url.find("://");
-  if (scheme_end == std::string_view::npos)
-    throw bad(url, "not a URL (ntrip://, tcp://, udp://, serial:// or lcm://)");
+  if (scheme_end == std::string_view::npos) throw bad(url, "not a URL (ntrip://, tcp://, udp://, serial:// or lcm://)");
   const std::string_view scheme = url.substr(0, scheme_end);
   const std::string_view rest = url.substr(scheme_end + 3);
   if (scheme == "ntrip") {

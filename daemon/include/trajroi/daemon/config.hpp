@@ -79,7 +79,7 @@ struct DaemonConfig {
   Eigen::Vector3d gnss_antenna_m = Eigen::Vector3d::Zero();  // in the robot frame
   // RTK corrections written into the u-blox through gnss.device (corrections_link.hpp).
   struct GnssCorrections {
-    std::string url;  // ntrip://, tcp://, udp://, serial://, lcm:// (corrections_url.hpp); empty: none
+    std::string url;               // ntrip://, tcp://, udp://, serial://, lcm:// (corrections_url.hpp); empty: none
     double gga_interval_s = 10.0;  // NTRIP: the rover's GGA to the caster this often (0: never)
     double stall_s = 10.0;         // no byte for this long: the stream is lost (reconnect)
     double max_age_s = 5.0;        // newest frame written longer ago than this: warned

@@ -95,6 +95,10 @@ class SweepProcessor {
   void set_host_utc_offset(std::optional<std::int64_t> offset_ns) noexcept { host_utc_offset_ns_ = offset_ns; }
   // Host UTC − GNSS UTC at the newest GNSS epoch with a valid time, s (NaN: not both known).
   [[nodiscard]] double host_minus_gnss_utc_s() const noexcept;
+  // NAV-PVT's time accuracy (tAcc) of that UTC, s (NaN: none).
+  [[nodiscard]] double gnss_time_accuracy_s() const noexcept;
+  // Host UTC − the VLP-16's PPS-locked UTC at the newest sweep it stamped (NaN: none, or not locked).
+  [[nodiscard]] double host_minus_lidar_utc_s() const noexcept { return host_minus_lidar_utc_s_; }
   // Ends the stream: the sweep in progress goes out (partial).
   void flush(SweepSink& sink);
   // Sweeps carry point_index from now on (the evaluations; the daemon does not need it).
@@ -155,6 +159,7 @@ class SweepProcessor {
   double s_hint_m_ = 0.0;
   double trajectory_distance_m_ = std::numeric_limits<double>::quiet_NaN();
   std::optional<std::int64_t> host_utc_offset_ns_;
+  double host_minus_lidar_utc_s_ = std::numeric_limits<double>::quiet_NaN();
   bool have_hint_ = false;
   std::optional<std::int64_t> valid_since_ns_;  // first sweep start of the current valid run
 

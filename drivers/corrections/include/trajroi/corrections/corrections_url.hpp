@@ -13,12 +13,12 @@ namespace trajroi::corrections {
 struct CorrectionsUrl {
   enum class Kind : std::uint8_t { kNtrip, kTcp, kUdp, kSerial, kLcm };
   Kind kind = Kind::kNtrip;
-  NtripUrl ntrip;             // kNtrip; kTcp uses its host and port
-  std::string bind_address;   // kUdp: the local address to bind ("0.0.0.0": any)
-  std::uint16_t port = 0;     // kUdp: the local port
-  std::string device;         // kSerial
-  int baud = 57600;           // kSerial (?baud=)
-  std::string channel;        // kLcm: on the daemon's LCM URL
+  NtripUrl ntrip;            // kNtrip; kTcp uses its host and port
+  std::string bind_address;  // kUdp: the local address to bind ("0.0.0.0": any)
+  std::uint16_t port = 0;    // kUdp: the local port
+  std::string device;        // kSerial
+  int baud = 57600;          // kSerial (?baud=)
+  std::string channel;       // kLcm: on the daemon's LCM URL
   // As the URL was given, without a password: for logs and the status.
   [[nodiscard]] std::string redacted() const;
 };

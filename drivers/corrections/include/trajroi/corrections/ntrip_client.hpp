@@ -32,7 +32,6 @@ struct NtripClientOptions {
   bool raw_tcp = false;  // a plain TCP stream of RTCM3: no NTRIP request, no answer, no GGA
 };
 
-
 class NtripClient final : public CorrectionSource {
  public:
   using GgaSource = std::function<std::string()>;  // the rover's GGA sentence, "" when no fix yet

@@ -52,7 +52,7 @@ struct PoseGate {
   std::uint8_t min_fix_type = 3;  // 3-D (4 = GNSS + dead reckoning also passes)
   bool require_gnss_fix_ok = true;
   double max_h_acc_m = 0.5;
-  RtkSolution require_rtk = RtkSolution::kNone;  // at least this carrier solution
+  RtkSolution require_rtk = RtkSolution::kNone;     // at least this carrier solution
   std::int64_t max_extrapolation_ns = 100'000'000;  // past the newest sample of each stream
   std::int64_t max_gap_ns = 1'000'000'000;          // between the two samples bracketing t
 };
