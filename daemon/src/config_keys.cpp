@@ -244,6 +244,21 @@ std::vector<ConfigKey> make_keys() {
       "time.max_gnss_offset_s", "number > 0",
       "host UTC − GNSS UTC (NAV-PVT) beyond this is warned: is NTP / chrony running?", Sign::kPositive,
       [](auto& c) -> auto& { return c.time.max_gnss_offset_s; }));
+  k.push_back(real_key(
+      "time.max_lidar_offset_s", "number > 0",
+      "host UTC − the VLP-16's PPS-locked UTC beyond this is warned: is chrony disciplining the host, the PPS right?",
+      Sign::kPositive, [](auto& c) -> auto& { return c.time.max_lidar_offset_s; }));
+  k.push_back({"time.chrony_shm", "none | integer in [0, 15]",
+               "live: each NAV-PVT's UTC to chrony's `refclock SHM N` (the segment chronyd made; docs/time.md)", false,
+               [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
+                 const std::optional<double> unit = optional_number(m, key);
+                 m.require(!unit || (*unit >= 0 && *unit <= 15 && *unit == std::floor(*unit)), key,
+                           "must be none or an SHM unit 0 … 15 (chrony's `refclock SHM N`)");
+                 c.time.chrony_shm = unit ? std::optional<int>(static_cast<int>(*unit)) : std::nullopt;
+               },
+               [](const DaemonConfig& c) {
+                 return c.time.chrony_shm ? std::to_string(*c.time.chrony_shm) : std::string("none");
+               }});
   k.push_back({"logging.level", "trace | debug | info | warn | error | critical | off", "the log's level", false,
                [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
                  c.logging.level =

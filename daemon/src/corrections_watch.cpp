@@ -22,9 +22,9 @@ CorrectionsFigures CorrectionsWatch::update(const StatusSnapshot& s, std::int64_
     } else if (solution == pose::RtkSolution::kFloat) {
       lines.push_back({HealthLine::Level::kInfo, sprintf_text("RTK float (h_acc %.3f m)", s.h_acc_m)});
     } else if (rtk_ > 0) {
-      lines.push_back({HealthLine::Level::kWarning,
-                       sprintf_text("RTK lost: standalone fix (h_acc %.2f m)%s", s.h_acc_m,
-                                    link_ != nullptr ? "; see the corrections' state" : "")});
+      lines.push_back(
+          {HealthLine::Level::kWarning, sprintf_text("RTK lost: standalone fix (h_acc %.2f m)%s", s.h_acc_m,
+                                                     link_ != nullptr ? "; see the corrections' state" : "")});
     }
     rtk_ = s.rtk;
   }
@@ -50,10 +50,11 @@ CorrectionsFigures CorrectionsWatch::update(const StatusSnapshot& s, std::int64_
                                   "gnss.max_correction_age_s %.1f s): %s",
                                   since_s, limit, c.state.c_str())});
   } else if (!old && old_) {
-    lines.push_back({HealthLine::Level::kInfo, sprintf_text("corrections flowing again (age %.1f s): %s", f.age_s,
-                                                            c.state.c_str())});
+    lines.push_back({HealthLine::Level::kInfo,
+                     sprintf_text("corrections flowing again (age %.1f s): %s", f.age_s, c.state.c_str())});
   }
   old_ = old;
+  not_rtcm3(c, now_ns, lines);
 
   add("corrections.bytes", c.in.bytes);
   add("corrections.frames", c.in.frames);
@@ -71,6 +72,46 @@ CorrectionsFigures CorrectionsWatch::update(const StatusSnapshot& s, std::int64_
   for (const auto& [number, count] : c.in.by_message)
     add("corrections.rtcm." + std::to_string(number), count);
   return f;
+}
+
+// Bytes that never make a frame (not RTCM3: RTCM2, CMR, a receiver's own output, a wrong baud
+// rate) and frames that fail their CRC (line noise on a radio): counted, and named here.
+void CorrectionsWatch::not_rtcm3(const CorrectionsStats& c, std::int64_t now_ns, std::vector<HealthLine>& lines) {
+  const std::uint64_t new_frames = c.in.frames - frames_;
+  const std::uint64_t new_other = c.in.other_bytes - other_bytes_;
+  frames_ = c.in.frames;
+  other_bytes_ = c.in.other_bytes;
+  if (new_frames > 0) {
+    frameless_s_ = 0;
+    frameless_bytes_ = 0;
+  } else if (new_other > 0) {
+    ++frameless_s_;
+    frameless_bytes_ += new_other;
+  }
+  if (frameless_s_ >= 3 && !frameless_said_) {
+    lines.push_back({HealthLine::Level::kWarning,
+                     sprintf_text("corrections: %llu bytes and no RTCM3 frame in %d s (%s): is the source's output "
+                                  "RTCM 3 (not RTCM 2, CMR or a receiver's own messages), and its baud rate right? "
+                                  "(corrections.not_rtcm3_bytes %llu)",
+                                  static_cast<unsigned long long>(frameless_bytes_), frameless_s_, c.state.c_str(),
+                                  static_cast<unsigned long long>(c.in.other_bytes))});
+    frameless_said_ = true;
+  } else if (new_frames > 0 && frameless_said_) {
+    lines.push_back(
+        {HealthLine::Level::kInfo, sprintf_text("corrections: RTCM3 frames arriving (%s)", c.state.c_str())});
+    frameless_said_ = false;
+  }
+  constexpr std::int64_t kMinute_ns = 60'000'000'000;
+  if (c.in.crc_errors > crc_said_ && (crc_said_ns_ == 0 || now_ns - crc_said_ns_ >= kMinute_ns)) {
+    lines.push_back({HealthLine::Level::kWarning,
+                     sprintf_text("corrections: %llu RTCM3 frames failed their CRC-24Q since %s (line noise on the "
+                                  "link?): not written into the receiver (corrections.crc_errors %llu)",
+                                  static_cast<unsigned long long>(c.in.crc_errors - crc_said_),
+                                  crc_said_ns_ == 0 ? "the start" : "the last such line",
+                                  static_cast<unsigned long long>(c.in.crc_errors))});
+    crc_said_ = c.in.crc_errors;
+    crc_said_ns_ = now_ns;
+  }
 }
 
 }  // namespace trajroi::daemon

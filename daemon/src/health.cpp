@@ -8,6 +8,7 @@
 #include "health_format.hpp"
 #include "trajroi/pipeline/pose_words.hpp"
 #include "trajroi/vlp16/packet.hpp"
+#include "trajroi/vlp16/position.hpp"
 
 namespace trajroi::daemon {
 
@@ -86,17 +87,37 @@ std::vector<HealthLine> HealthMonitor::update(const StatusSnapshot& s) {
           s.trajectory_id, s.trajectory_distance_m, far_m),
       sprintf_text("trajectory %d: the robot is back within %.0f m of it", s.trajectory_id, far_m), out);
 
-  // The host clock against GNSS time (live: in a replay the recording's receiver is not now).
-  const double offset = s.host_minus_gnss_utc_s;
-  set(kClockOffset, live_ && std::isfinite(offset) && std::abs(offset) > config_.time.max_gnss_offset_s,
-      sprintf_text(
-          "time: the host clock is %.3f s %s GNSS UTC (more than time.max_gnss_offset_s %.3f s): is NTP/chrony "
-          "running and synchronised?",
-          std::abs(offset), offset > 0 ? "ahead of" : "behind", config_.time.max_gnss_offset_s),
-      sprintf_text("time: the host clock is within %.3f s of GNSS UTC", config_.time.max_gnss_offset_s), out);
-
+  clocks(s, out);
   update_state(s, previous);
   return out;
+}
+
+// Live only: in a replay the recording's receiver and sensor are not now.
+void HealthMonitor::clocks(const StatusSnapshot& s, std::vector<HealthLine>& out) {
+  const double gnss = s.host_minus_gnss_utc_s;
+  const double limit = config_.time.max_gnss_offset_s;
+  set(kClockOffset, live_ && std::isfinite(gnss) && std::abs(gnss) > limit,
+      sprintf_text("time: the host clock is %.3f s %s GNSS UTC (NAV-PVT, time accuracy %.3g s; more than "
+                   "time.max_gnss_offset_s %.3f s): is NTP/chrony running and synchronised?",
+                   std::abs(gnss), gnss > 0 ? "ahead of" : "behind", s.gnss_time_accuracy_s, limit),
+      sprintf_text("time: the host clock is within %.3f s of GNSS UTC", limit), out);
+  const double lidar = s.host_minus_lidar_utc_s;
+  const double lidar_limit = config_.time.max_lidar_offset_s;
+  set(kLidarClockOffset, live_ && std::isfinite(lidar) && std::abs(lidar) > lidar_limit,
+      sprintf_text("time: the host clock is %.3f s %s the VLP-16's PPS-locked UTC (more than "
+                   "time.max_lidar_offset_s %.3f s): is the host clock synchronised (chrony), and the sensor's "
+                   "GPS time right?",
+                   std::abs(lidar), lidar > 0 ? "ahead of" : "behind", lidar_limit),
+      sprintf_text("time: the host clock is within %.3f s of the VLP-16's UTC", lidar_limit), out);
+  // The VLP-16's PPS, once locked, lost: its stamps run on its own clock until it locks again.
+  const auto pps = static_cast<vlp16::PpsStatus>(static_cast<std::uint8_t>(s.lidar_pps_status));
+  if (s.lidar_pps_status >= 0 && pps == vlp16::PpsStatus::kLocked) lidar_pps_locked_once_ = true;
+  const bool lost = live_ && lidar_pps_locked_once_ && s.lidar_pps_status >= 0 && pps != vlp16::PpsStatus::kLocked;
+  set(kLidarPpsLost, lost,
+      "lidar: the VLP-16's PPS is " + std::string(vlp16::to_string(pps)) +
+          " after it had locked: its time stamps follow its own clock until it locks again (GPS receiver, antenna or "
+          "PPS wire?)",
+      "lidar: the VLP-16's PPS is locked again", out);
 }
 
 void HealthMonitor::lidar(const StatusSnapshot& s, std::vector<HealthLine>& out) {

@@ -53,6 +53,8 @@ class HealthMonitor {
     kLocalizationMalformed,
     kTrajectoryFar,
     kClockOffset,
+    kLidarClockOffset,
+    kLidarPpsLost,
     kFaultCount
   };
   // Raises or clears `fault`: true → the warning (once, as it starts); false → the info line
@@ -63,6 +65,8 @@ class HealthMonitor {
   void serial_ports(const StatusSnapshot& s, std::vector<HealthLine>& out);
   void localization(const StatusSnapshot& s, std::vector<HealthLine>& out);
   void minute_summary(const StatusSnapshot& s, std::vector<HealthLine>& out);
+  // The host clock against GNSS time and the VLP-16's; the VLP-16's PPS.
+  void clocks(const StatusSnapshot& s, std::vector<HealthLine>& out);
   // The state in words, from the faults now active.
   void update_state(const StatusSnapshot& s, const StatusSnapshot& previous);
   // The counters' change over the window (the oldest snapshot kept to `s`).
@@ -80,6 +84,7 @@ class HealthMonitor {
   bool live_;
   std::deque<StatusSnapshot> history_;  // oldest first; the first is the all-zero start
   bool active_[kFaultCount] = {};
+  bool lidar_pps_locked_once_ = false;
   // Each serial port's fault in a few words for the state ("NMEA text, no UBX"): GNSS, IMU.
   std::string serial_state_[2];
   StatusSnapshot minute_start_;  // the mixed LiDAR port's summary

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <thread>
 
+#include "chrony_shm.hpp"
 #include "corrections_link.hpp"
 #include "status.hpp"
 

@@ -135,6 +135,7 @@ struct TrajectoryItem {
 
 struct StatusSnapshot;
 class CorrectionsLink;
+class ChronyShm;
 
 struct Pipeline {
   // `exact`: an as-fast-as-possible replay, where a full ring is waited on (the output is
@@ -178,6 +179,8 @@ struct Pipeline {
   std::string record_dir;                   // its folder (set before the threads start)
   // gnss.corrections on a live GNSS port (set before the threads start; else null).
   std::unique_ptr<CorrectionsLink> corrections;
+  // time.chrony_shm on a live GNSS port: written by the processing thread (else null).
+  std::unique_ptr<ChronyShm> chrony;
   std::atomic<bool> record_failed{false};  // the recorder stopped on an error (logged)
   std::atomic<bool> processing_done{false}, publishing_done{false};
   // The processing thread is about to wait for input, or waits: an as-fast-as-possible

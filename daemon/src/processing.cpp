@@ -5,6 +5,7 @@
 #include <limits>
 #include <thread>
 
+#include "chrony_shm.hpp"
 #include "corrections_link.hpp"
 #include "log.hpp"
 #include "realtime.hpp"
@@ -80,15 +81,39 @@ class Processing {
       sink_.packet_done(host::monotonic_ns());
     } else {
       processor_.process(input, sink_);
-      // A new NAV-PVT: the rover's position for the corrections' caster (GGA).
-      if (pipeline_.corrections && item.stream == inputs::Stream::kGnss) {
-        const pose_input::PoseInput& pose = processor_.pose_input();
-        if (pose.pvt_count() != pvt_seen_ && pose.newest_pvt()) pipeline_.corrections->offer_rover(*pose.newest_pvt());
-        pvt_seen_ = pose.pvt_count();
-      }
+      if (item.stream == inputs::Stream::kGnss) new_pvt(item.receive_ns);
     }
     if (pipeline_.record) (void)pipeline_.record->push([&item](InputSlot& slot) { slot = item; });
     lane.ring->release();
+  }
+
+  // A new NAV-PVT (received at `receive_ns`): the rover's position for the corrections'
+  // caster (GGA), its UTC for chrony against the raw receive time (the jitter of the serial
+  // line is chrony's to filter; a mapped time would drift with the host's clock).
+  void new_pvt(std::int64_t receive_ns) {
+    const pose_input::PoseInput& pose = processor_.pose_input();
+    if (pose.pvt_count() == pvt_seen_ || !pose.newest_pvt()) return;
+    pvt_seen_ = pose.pvt_count();
+    const ublox::NavPvt& pvt = *pose.newest_pvt();
+    if (pipeline_.corrections) pipeline_.corrections->offer_rover(pvt);
+    if (pipeline_.chrony && pvt.utc_valid()) {
+      constexpr int kSerialPrecision = -7;  // ≈ 8 ms: a serial message's arrival, not a PPS edge
+      pipeline_.chrony->put(pvt.utc_ns(), receive_ns + host::realtime_ns() - host::monotonic_ns(), kSerialPrecision);
+    }
+  }
+
+  // time.chrony_shm: attached once chronyd has made the segment; why not, said once per reason.
+  void attach_chrony(std::int64_t now) {
+    if (!pipeline_.chrony || pipeline_.chrony->attached() || now < next_chrony_attach_) return;
+    next_chrony_attach_ = now + 10 * kSecond_ns;
+    const std::string why = pipeline_.chrony->attach();
+    if (why.empty()) {
+      log::info("time.chrony_shm {}: writing each NAV-PVT's UTC into chronyd's SHM {} refclock",
+                pipeline_.chrony->unit(), pipeline_.chrony->unit());
+    } else if (why != chrony_why_) {
+      log::warn("time.chrony_shm {}: {} (tried again every 10 s)", pipeline_.chrony->unit(), why);
+    }
+    chrony_why_ = why;
   }
 
   // Trajectories offered by the publisher come in; retired ones go back to be freed there.
@@ -112,6 +137,7 @@ class Processing {
 
   void run(const ProcessingOptions& options) {
     std::int64_t next_status = host::monotonic_ns() + kSecond_ns;
+    attach_chrony(host::monotonic_ns());
     if (options.live) processor_.set_host_utc_offset(host::realtime_ns() - host::monotonic_ns());
     const std::int64_t stall_at = options.stall_after_s
                                       ? host::monotonic_ns() + static_cast<std::int64_t>(*options.stall_after_s * 1e9)
@@ -137,6 +163,7 @@ class Processing {
 
       const std::int64_t now = host::monotonic_ns();
       if (now >= next_status) {
+        attach_chrony(now);
         if (options.live) processor_.set_host_utc_offset(host::realtime_ns() - host::monotonic_ns());
         snapshot(false);
         next_status += kSecond_ns;
@@ -164,6 +191,8 @@ class Processing {
   RingSink sink_;
   std::int64_t last_receive_ns_ = 0;
   std::uint64_t pvt_seen_ = 0;
+  std::int64_t next_chrony_attach_ = 0;
+  std::string chrony_why_;
 };
 
 }  // namespace

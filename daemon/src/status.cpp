@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "chrony_shm.hpp"
 #include "pipeline.hpp"
 
 namespace trajroi::daemon {
@@ -131,6 +132,7 @@ void fill_snapshot(const pipeline::SweepProcessor& p, const Pipeline& pipeline, 
     s[C::kSerialDisconnects] += lane->disconnects.load(std::memory_order_relaxed);
     s[C::kLidarSourceErrors] += lane->errors.load(std::memory_order_relaxed);
   }
+  s[C::kChronySamples] = pipeline.chrony ? pipeline.chrony->samples() : 0;
   s[C::kRingDropsSweeps] = pipeline.sweeps.dropped();
   s[C::kRingDropsStatus] = pipeline.status->dropped();
   s[C::kRingDropsTrajectory] = pipeline.trajectories_in.dropped();

@@ -83,7 +83,8 @@ struct Pipeline;
   X(kGnssRtcm3, "gnss.rtcm3_frames")                                                 \
   X(kImuNmea, "imu.nmea_sentences")                                                  \
   X(kImuVnAscii, "imu.vn100_ascii_sentences")                                        \
-  X(kImuRtcm3, "imu.rtcm3_frames")
+  X(kImuRtcm3, "imu.rtcm3_frames")                                                   \
+  X(kChronySamples, "time.chrony_samples")
 
 enum class Counter : std::uint16_t {
 #define TRAJROI_COUNTER_ID(id, name) id,

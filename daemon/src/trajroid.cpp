@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "chrony_shm.hpp"
 #include "corrections_link.hpp"
 #include "lcm_pose_input.hpp"
 #include "log.hpp"
@@ -68,6 +69,7 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
   if (options.replay) {
     if (!config.gnss_corrections.url.empty())
       log::info("gnss.corrections.url: not used in a replay (no receiver to write into)");
+    if (config.time.chrony_shm) log::info("time.chrony_shm: not used in a replay (the recording's time is not now)");
     inputs::RecordedOptions recorded;
     recorded.rate = options.rate;
     recorded.loop = options.loop;
@@ -112,6 +114,14 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
   // What the pose source reads (a device configured for an unused stream is left closed).
   if (config.pose_source == PoseSource::kGnssImu || config.pose_source == PoseSource::kGnss) {
     add_serial(config.gnss, "gnss", inputs::Stream::kGnss, config.realtime.gnss);
+  }
+  if (config.time.chrony_shm) {
+    if (config.pose_source == PoseSource::kGnssImu || config.pose_source == PoseSource::kGnss) {
+      pipeline.chrony = std::make_unique<ChronyShm>(*config.time.chrony_shm);
+    } else {
+      log::warn("time.chrony_shm is set but trajroid reads no GNSS port (pose.source {}): no time for chrony",
+                to_string(config.pose_source));
+    }
   }
   if (!config.gnss_corrections.url.empty() && !pipeline.corrections) {
     log::warn(

@@ -56,8 +56,8 @@ class Caster {
   Caster(std::uint16_t input_port, std::uint16_t caster_port)
       : Caster(input_port, "ntripc://rover:s3cret@:" + std::to_string(caster_port) + "/F9T") {}
   Caster(std::uint16_t input_port, const std::string& str2str_output)
-      : Caster(input_port, std::vector<std::string>{"str2str", "-in", "tcpsvr://:" + std::to_string(input_port),
-                                                    "-out", str2str_output}) {}
+      : Caster(input_port, std::vector<std::string>{"str2str", "-in", "tcpsvr://:" + std::to_string(input_port), "-out",
+                                                    str2str_output}) {}
   Caster(std::uint16_t input_port, std::vector<std::string> argv) : input_(input_port), argv_(std::move(argv)) {
     start();
   }
@@ -67,7 +67,9 @@ class Caster {
                                                        "UDP-SENDTO:127.0.0.1:" + std::to_string(udp_port)});
   }
   Caster(Caster&& other) noexcept
-      : input_(other.input_), argv_(std::move(other.argv_)), pid_(std::exchange(other.pid_, -1)),
+      : input_(other.input_),
+        argv_(std::move(other.argv_)),
+        pid_(std::exchange(other.pid_, -1)),
         input_fds_(std::move(other.input_fds_)) {}
   Caster& operator=(Caster&&) = delete;
   ~Caster() { stop(); }
@@ -156,10 +158,10 @@ inline Bytes with_noise(const std::vector<Bytes>& frames, std::size_t from, std:
   return out;
 }
 
-#define REQUIRE_STREAM_PEERS()                                                                                 \
-  if (!have_peers()) {                                                                                    \
-    const char* ci = std::getenv("CI");                                                                   \
-    if (ci != nullptr && std::string(ci) == "true") FAIL() << "str2str or socat missing under CI";        \
+#define REQUIRE_STREAM_PEERS()                                                                                \
+  if (!have_peers()) {                                                                                        \
+    const char* ci = std::getenv("CI");                                                                       \
+    if (ci != nullptr && std::string(ci) == "true") FAIL() << "str2str or socat missing under CI";            \
     GTEST_SKIP() << "str2str (Debian rtklib) or socat not installed (scripts/install-deps.sh installs them)"; \
   }
 

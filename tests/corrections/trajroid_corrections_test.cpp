@@ -5,22 +5,14 @@
 // acknowledging trajroid's configuration. What the receiver side reads must be exactly the
 // valid frames in order (the bit-flipped copies and the noise between them never), besides
 // trajroid's own configuration messages; across a caster restart nothing is written twice.
-#include <fcntl.h>
-#include <poll.h>
-#include <stdlib.h>
-#include <termios.h>
 
-#include <atomic>
-#include <mutex>
 #include <thread>
 
 #include "daemon_fixture.hpp"
+#include "pty_receiver.hpp"
 #include "stream_peers.hpp"
 #include "test_data.hpp"
 #include "trajroi/rtcm_t.hpp"
-#include "trajroi/ublox/config.hpp"
-#include "trajroi/ublox/framer.hpp"
-#include "trajroi/ublox/messages.hpp"
 
 namespace {
 
@@ -30,107 +22,6 @@ using daemon_test::Child;
 using daemon_test::counter;
 using daemon_test::Listener;
 namespace fs = std::filesystem;
-
-// The u-blox side of a pseudo-terminal: plays `log` one navigation epoch (up to and with each
-// NAV-PVT) per `epoch` (the ZED-F9R log's 1 Hz), over again at its end; acknowledges every
-// CFG message trajroid writes; keeps every byte trajroid writes.
-class Receiver {
- public:
-  Receiver(const std::string& log, std::chrono::milliseconds epoch) : epoch_(epoch) {
-    master_ = posix_openpt(O_RDWR | O_NOCTTY | O_NONBLOCK);
-    EXPECT_GE(master_, 0);
-    EXPECT_EQ(grantpt(master_), 0);
-    EXPECT_EQ(unlockpt(master_), 0);
-    path_ = ptsname(master_);
-    // Raw from the start: a line discipline still in its default mode (before trajroid opens the
-    // port) would echo the receiver's own bytes back as if trajroid had written them.
-    termios t{};
-    EXPECT_EQ(tcgetattr(master_, &t), 0);
-    cfmakeraw(&t);
-    EXPECT_EQ(tcsetattr(master_, TCSANOW, &t), 0);
-    // Epochs: the bytes up to the end of each NAV-PVT.
-    std::size_t from = 0;
-    for (std::size_t at = log.find("\xB5\x62\x01\x07"); at != std::string::npos;
-         at = log.find("\xB5\x62\x01\x07", at + 4)) {
-      if (at + 6 > log.size()) break;
-      const std::size_t length = static_cast<std::uint8_t>(log[at + 4]) | static_cast<std::uint8_t>(log[at + 5]) << 8;
-      const std::size_t end = std::min(log.size(), at + 8 + length);
-      epochs_.emplace_back(log.begin() + static_cast<std::ptrdiff_t>(from), log.begin() + static_cast<std::ptrdiff_t>(end));
-      from = end;
-    }
-    thread_ = std::thread([this] { serve(); });
-  }
-  ~Receiver() {
-    stop_ = true;
-    thread_.join();
-    close(master_);
-  }
-  [[nodiscard]] const std::string& path() const { return path_; }
-  [[nodiscard]] Bytes written() {
-    const std::lock_guard lock(mutex_);
-    return written_;
-  }
-  // The RTCM3 frames among the bytes written, and the UBX frames (class, id) with them.
-  struct Split {
-    std::vector<Bytes> rtcm;
-    std::vector<std::pair<std::uint8_t, std::uint8_t>> ubx;
-    std::size_t rtcm_bytes = 0, ubx_bytes = 0, total = 0;
-  };
-  Split split() {
-    const Bytes all = written();
-    Split s;
-    s.total = all.size();
-    framing::Rtcm3Framer rtcm;
-    rtcm.feed(all, [&](std::span<const std::uint8_t> f) {
-      s.rtcm.emplace_back(f.begin(), f.end());
-      s.rtcm_bytes += f.size();
-    });
-    ublox::Framer ubx;
-    ubx.feed(all, [&](const ublox::Message& m) {
-      s.ubx.emplace_back(m.msg_class, m.msg_id);
-      s.ubx_bytes += m.payload.size() + 8;
-    });
-    return s;
-  }
-
- private:
-  void serve() {
-    ublox::Framer framer;
-    auto next_epoch = std::chrono::steady_clock::now();
-    std::size_t epoch = 0;
-    std::uint8_t buffer[4096];
-    while (!stop_) {
-      if (std::chrono::steady_clock::now() >= next_epoch && !epochs_.empty()) {
-        const std::string& bytes = epochs_[epoch++ % epochs_.size()];
-        (void)!write(master_, bytes.data(), bytes.size());
-        next_epoch += epoch_;
-      }
-      pollfd p{master_, POLLIN, 0};
-      if (poll(&p, 1, 10) <= 0 || (p.revents & POLLIN) == 0) continue;
-      const ssize_t n = read(master_, buffer, sizeof buffer);
-      if (n <= 0) continue;
-      const std::span<const std::uint8_t> got(buffer, static_cast<std::size_t>(n));
-      {
-        const std::lock_guard lock(mutex_);
-        written_.insert(written_.end(), got.begin(), got.end());
-      }
-      framer.feed(got, [&](const ublox::Message& m) {
-        if (m.msg_class != 0x06) return;
-        const std::vector<std::uint8_t> payload{m.msg_class, m.msg_id};
-        const auto ack = ublox::encode_frame(ublox::kClassAck, 0x01, payload);
-        (void)!write(master_, ack.data(), ack.size());
-      });
-    }
-  }
-  std::chrono::milliseconds epoch_;
-  std::vector<std::string> epochs_;
-  int master_ = -1;
-  std::string path_;
-  std::mutex mutex_;
-  Bytes written_;
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
-};
 
 // A run folder with trajroid's configuration for `url` on channels `prefix`_*.
 fs::path write_config(const std::string& prefix, const std::string& device, const std::string& url) {
@@ -147,23 +38,9 @@ fs::path write_config(const std::string& prefix, const std::string& device, cons
       << "pose:\n  source: gnss\n  gnss_heading: {initial_heading_deg: 90}\n  require_rtk: fixed\n"
       << "  max_extrapolation_s: 1.5\n"
       << "lcm:\n  channels: {points: " << prefix << "_POINTS, pose: " << prefix << "_POSE, roi: " << prefix
-      << "_ROI, status: " << prefix << "_STATUS, trajectory: " << prefix << "_TRAJECTORY, active_trajectory: "
-      << prefix << "_ACTIVE}\n";
+      << "_ROI, status: " << prefix << "_STATUS, trajectory: " << prefix << "_TRAJECTORY, active_trajectory: " << prefix
+      << "_ACTIVE}\n";
   return dir;
-}
-
-// Waits until the log holds `text` at least `times` times.
-bool log_says(const fs::path& log, const std::string& text, int times = 1, double seconds = 15.0) {
-  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<int>(seconds * 1000));
-  while (std::chrono::steady_clock::now() < until) {
-    const std::string s = daemon_test::slurp(log);
-    int n = 0;
-    for (std::size_t at = s.find(text); at != std::string::npos; at = s.find(text, at + 1))
-      ++n;
-    if (n >= times) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  return false;
 }
 
 bool wait_frames(Receiver& rx, std::size_t n, double seconds = 15.0) {
@@ -204,9 +81,8 @@ void expect_status(Listener& listener, const std::vector<Bytes>& frames, std::si
                    const std::string& state_start) {
   ASSERT_TRUE(listener.wait_for(
       [&] {
-        return !listener.statuses.empty() &&
-               counter(listener.statuses.back(), "corrections.written_frames") ==
-                   static_cast<std::int64_t>(frames.size());
+        return !listener.statuses.empty() && counter(listener.statuses.back(), "corrections.written_frames") ==
+                                                 static_cast<std::int64_t>(frames.size());
       },
       std::chrono::seconds(5)));
   const std::lock_guard lock(listener.mutex);
@@ -227,10 +103,10 @@ void expect_status(Listener& listener, const std::vector<Bytes>& frames, std::si
       << s.pose_status;
 }
 
-#define REQUIRE_RIG(rig)                                                                       \
-  REQUIRE_STREAM_PEERS();                                                                           \
-  TRAJROI_REQUIRE_DATA(corrections_path, "ublox/gpsd/ublox-zed-f9t-rtcm3.log");                \
-  TRAJROI_REQUIRE_DATA(rover_path, "ublox/gpsd/ublox-zed-f9r.log");                            \
+#define REQUIRE_RIG(rig)                                                                                       \
+  REQUIRE_STREAM_PEERS();                                                                                      \
+  TRAJROI_REQUIRE_DATA(corrections_path, "ublox/gpsd/ublox-zed-f9t-rtcm3.log");                                \
+  TRAJROI_REQUIRE_DATA(rover_path, "ublox/gpsd/ublox-zed-f9r.log");                                            \
   const Rig rig{log_frames(trajroi::test::read_file(corrections_path)), trajroi::test::read_file(rover_path)}; \
   ASSERT_EQ(rig.frames.size(), 182U)
 
@@ -266,6 +142,8 @@ TEST(TrajroidCorrections, NtripCasterFramesReachTheReceiverExactlyOnceAcrossARes
     EXPECT_EQ(counter(listener.statuses.back(), "corrections.connects"), 2);
   }
   EXPECT_TRUE(log_says(log, "RTK float")) << daemon_test::slurp(log);
+  EXPECT_TRUE(log_says(log, "RTCM3 frames failed their CRC-24Q since the start (line noise on the link?)"))
+      << daemon_test::slurp(log);
   trajroid.signal(SIGTERM);
   EXPECT_EQ(trajroid.wait(std::chrono::seconds(10)), 0) << daemon_test::slurp(log);
   expect_exactly(rx, rig.frames);
@@ -301,12 +179,12 @@ TEST(TrajroidCorrections, TcpAndUdpStreamsReachTheReceiverExactly) {
   for (const std::string kind : {"tcp", "udp"}) {
     SCOPED_TRACE(kind);
     const std::uint16_t input = free_port(), port = free_port();
-    Caster server = kind == "tcp" ? Caster(input, "tcpsvr://:" + std::to_string(port))
-                                  : Caster::udp_sender(input, port);
+    Caster server =
+        kind == "tcp" ? Caster(input, "tcpsvr://:" + std::to_string(port)) : Caster::udp_sender(input, port);
     Receiver rx(rig.rover, std::chrono::milliseconds(1000));
     const std::string prefix = "RTK_" + kind;
-    const std::string url = kind == "tcp" ? "tcp://127.0.0.1:" + std::to_string(port)
-                                          : "udp://127.0.0.1:" + std::to_string(port);
+    const std::string url =
+        kind == "tcp" ? "tcp://127.0.0.1:" + std::to_string(port) : "udp://127.0.0.1:" + std::to_string(port);
     const fs::path dir = write_config(prefix, rx.path(), url);
     Listener listener(prefix);
     const fs::path log = dir / "trajroid.log";
@@ -323,6 +201,38 @@ TEST(TrajroidCorrections, TcpAndUdpStreamsReachTheReceiverExactly) {
     server.close_inputs();
     fs::remove_all(dir);
   }
+}
+
+// A stream that is not RTCM3 (a VN-100's binary output wired to the radio port by mistake): named,
+// nothing written.
+TEST(TrajroidCorrections, AStreamThatIsNotRtcm3IsNamedAndNothingIsWritten) {
+  REQUIRE_RIG(rig);
+  TRAJROI_REQUIRE_DATA(vn100_path, "vectornav/LoggerWavesInIce_F00379.raw");
+  const std::string vn100 = trajroi::test::read_file(vn100_path);
+  const std::uint16_t input = free_port(), port = free_port();
+  Caster server(input, "tcpsvr://:" + std::to_string(port));
+  Receiver rx(rig.rover, std::chrono::milliseconds(1000));
+  const std::string prefix = "RTK_NOT_RTCM3";
+  const std::string url = "tcp://127.0.0.1:" + std::to_string(port);
+  const fs::path dir = write_config(prefix, rx.path(), url);
+  const fs::path log = dir / "trajroid.log";
+  Child trajroid({"--config", (dir / "trajroid.yaml").string(), "--lcm-url", daemon_test::kTestLcmUrl}, log);
+  ASSERT_TRUE(log_says(log, "corrections: connected to tcp://")) << daemon_test::slurp(log);
+  // Four seconds of the VN-100's output, a piece each second.
+  for (int second = 0; second < 4; ++second) {
+    const std::size_t at = static_cast<std::size_t>(second) * 4096;
+    server.write(
+        Bytes(vn100.begin() + static_cast<std::ptrdiff_t>(at), vn100.begin() + static_cast<std::ptrdiff_t>(at + 4096)));
+    std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+  }
+  EXPECT_TRUE(log_says(log, "and no RTCM3 frame in 3 s (streaming from " + url +
+                                "): is the source's output RTCM 3 (not RTCM 2, CMR or a receiver's own messages)"))
+      << daemon_test::slurp(log);
+  trajroid.signal(SIGTERM);
+  EXPECT_EQ(trajroid.wait(std::chrono::seconds(10)), 0) << daemon_test::slurp(log);
+  EXPECT_TRUE(rx.split().rtcm.empty());
+  server.close_inputs();
+  fs::remove_all(dir);
 }
 
 // rtcm_t on LCM, published with liblcm by a "base station" elsewhere: the frames cut at

@@ -200,9 +200,37 @@ TEST(Health, AHostClockFarFromGnssTimeIsWarnedWithTheOffset) {
   const Said said = run(live_config(), 4, [](StatusSnapshot& s, int t) {
     healthy(s, t);
     s.host_minus_gnss_utc_s = t < 3 ? 0.02 : -2.5;
+    s.gnss_time_accuracy_s = 21e-9;
   });
-  EXPECT_EQ(said.first("time: the host clock is 2.500 s behind GNSS UTC (more than time.max_gnss_offset_s 0.100 s)"), 3)
+  EXPECT_EQ(said.first("time: the host clock is 2.500 s behind GNSS UTC (NAV-PVT, time accuracy 2.1e-08 s; more than "
+                       "time.max_gnss_offset_s 0.100 s)"),
+            3)
       << said.all();
+}
+
+TEST(Health, AHostClockFarFromTheLidarsTimeIsWarnedAndItsReturnSaid) {
+  DaemonConfig config = live_config();
+  config.time.max_lidar_offset_s = 0.05;
+  const Said said = run(config, 6, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s.host_minus_lidar_utc_s = t == 3 || t == 4 ? 0.25 : 0.01;
+  });
+  EXPECT_EQ(said.first("time: the host clock is 0.250 s ahead of the VLP-16's PPS-locked UTC (more than "
+                       "time.max_lidar_offset_s 0.050 s)"),
+            3)
+      << said.all();
+  EXPECT_EQ(said.first("time: the host clock is within 0.050 s of the VLP-16's UTC"), 5) << said.all();
+}
+
+TEST(Health, TheLidarsPpsLostAfterItHadLockedIsNamed) {
+  const Said said = run(live_config(), 6, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    // Synchronizing at power-up is not a loss; locked, then lost, then locked again is.
+    s.lidar_pps_status = static_cast<std::int8_t>(t == 1 ? 1 : t == 4 ? 0 : 2);
+  });
+  EXPECT_EQ(said.first("lidar: the VLP-16's PPS is"), 4) << said.all();
+  EXPECT_EQ(said.first("lidar: the VLP-16's PPS is absent after it had locked"), 4) << said.all();
+  EXPECT_EQ(said.first("lidar: the VLP-16's PPS is locked again"), 5) << said.all();
 }
 
 TEST(Health, TheStateSaysWhyThereIsNoPose) {

@@ -61,6 +61,41 @@ def start_view(cli, url, port, log):
     return p
 
 
+def fixed(v, digits):
+    return "–" if v is None or v != v else "%.*f" % (digits, v)
+
+
+def panel_text(s):
+    """The pose, corrections and time lines the page writes for status_t `s` (view.js)."""
+    nan = lambda v: v != v  # noqa: E731
+    pose = ["pose (%s) %s" % (s.pose_source, "valid" if s.pose_valid else "NOT valid: " + s.pose_status)]
+    if not nan(s.pose_age_s):
+        pose.append("age %s s" % fixed(s.pose_age_s, 2))
+    if s.fix_type >= 0:
+        pose.append("fix %d" % s.fix_type + ("" if nan(s.h_acc_m) else ", hAcc %s m" % fixed(s.h_acc_m, 2)))
+    if s.rtk_solution >= 0:
+        pose.append("RTK " + ["none", "float", "fixed"][s.rtk_solution])
+    corrections = []
+    if s.corrections:
+        corrections = ["corrections: " + s.corrections,
+                       "age none written" if nan(s.correction_age_s) else "age %s s" % fixed(s.correction_age_s, 1)]
+        if not nan(s.corrections_bytes_per_s):
+            corrections.append("%s B/s" % fixed(s.corrections_bytes_per_s, 0))
+    ms = lambda v: ("+" if v >= 0 else "") + fixed(1000 * v, 1) + " ms"  # noqa: E731
+    time_parts = []
+    if not nan(s.host_minus_gnss_utc_s):
+        time_parts.append("host − GNSS " + ms(s.host_minus_gnss_utc_s) + (
+            "" if nan(s.gnss_time_accuracy_s) else " (tAcc %s ns)" % fixed(1e9 * s.gnss_time_accuracy_s, 0)))
+    if not nan(s.host_minus_lidar_utc_s):
+        time_parts.append("host − LiDAR " + ms(s.host_minus_lidar_utc_s))
+    if s.lidar_pps_status >= 0:
+        time_parts.append("LiDAR PPS " + ["absent", "synchronizing", "locked", "error"][s.lidar_pps_status])
+    if s.lidar_gprmc_valid >= 0:
+        time_parts.append("GPRMC " + ("valid" if s.lidar_gprmc_valid else "invalid"))
+    return {"pose": " · ".join(pose), "corrections": " · ".join(corrections),
+            "time": "time: " + " · ".join(time_parts) if time_parts else "time: no GNSS or LiDAR time yet"}
+
+
 def main():
     cli, trajroid, scenario, out = sys.argv[1:5]
     need("chromium", "chromium")
@@ -129,13 +164,14 @@ def main():
         shown = stats()
         counters = browser.text("counters")
         raw_counters = browser.text("raw-counters")
+        panel = {k: browser.text(k) for k in ("pose", "corrections", "time")}
         dom = browser.dom()
         with open(os.path.join(work, "page.html"), "w") as f:
             f.write(dom)
         spots = browser.script("return window.trajroiProject(400);")
         shot = os.path.join(out, "view-screenshot.png")
         browser.screenshot(shot)
-        print("page: " + counters + " | " + raw_counters)
+        print("page: " + counters + " | " + raw_counters + " | " + " | ".join(panel.values()))
 
         # The replay ends: the page says no data comes.
         daemon.wait(120)
@@ -154,7 +190,7 @@ def main():
                     p.kill()
 
     # What trajroid published, as lcm-logger logged it.
-    points, rois, raws, trajectories = {}, {}, {}, []
+    points, rois, raws, trajectories, statuses = {}, {}, {}, [], []
     for channel, _, data in trajroi_lcm.read_log(log_path):
         if channel == "TRAJROI_POINTS":
             m = trajroi_lcm.decode(data)
@@ -167,6 +203,8 @@ def main():
             raws[m.sweep_index] = m
         elif channel == "TRAJROI_ACTIVE_TRAJECTORY":
             trajectories.append(trajroi_lcm.decode(data))
+        elif channel == "TRAJROI_STATUS":
+            statuses.append(trajroi_lcm.decode(data))
     check(len(points) > 100, "lcm-logger logged %d sweeps" % len(points))
     expected = "sweeps received %d · sweep %d · points %d · ROIs %d" % (
         shown["sweepsReceived"], shown["lastSweep"], points[shown["lastSweep"]].num_points,
@@ -179,6 +217,11 @@ def main():
     check(shown["rawDrawn"] == raw.num_points,
           "decoded points drawn %d = raw points_t of sweep %d: %d (of %d decoded)" % (
               shown["rawDrawn"], shown["rawSweep"], raw.num_points, raw.points_in))
+
+    # The panel's pose, corrections and time lines are one status message's, in words.
+    shown_panels = [panel_text(s) for s in statuses]
+    check(any(p == panel for p in shown_panels),
+          "the panel %s is a published status_t's (the last: %s)" % (panel, shown_panels[-1] if shown_panels else None))
 
     # The active trajectory trajroid published (once a second): the run's (id 0), then the
     # planner's (id 7), in the global frame, as the sweeps used them.

@@ -233,6 +233,12 @@ class Viewer {
     j.field("pose_source", std::string_view(m->pose_source)).field("pose_valid", m->pose_valid != 0);
     j.field("pose_status", std::string_view(m->pose_status)).field("pose_age_s", m->pose_age_s);
     j.field("fix_type", std::int64_t{m->fix_type}).field("h_acc_m", m->h_acc_m);
+    j.field("rtk_solution", std::int64_t{m->rtk_solution}).field("corrections", std::string_view(m->corrections));
+    j.field("correction_age_s", m->correction_age_s).field("corrections_bytes_per_s", m->corrections_bytes_per_s);
+    j.field("host_minus_gnss_utc_s", m->host_minus_gnss_utc_s).field("gnss_time_accuracy_s", m->gnss_time_accuracy_s);
+    j.field("host_minus_lidar_utc_s", m->host_minus_lidar_utc_s);
+    j.field("lidar_pps_status", std::int64_t{m->lidar_pps_status});
+    j.field("lidar_gprmc_valid", std::int64_t{m->lidar_gprmc_valid});
     j.field("trajectory_id", std::int64_t{m->trajectory_id}).field("replay", m->replay != 0);
     j.field("sweeps", m->sweeps).field("sweeps_published", m->sweeps_published);
     j.field("recording", std::string_view(m->recording)).end_object();

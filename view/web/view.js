@@ -153,6 +153,8 @@
   var dirty = true, drewSweep = null, lastSweep = null, lastIntensity = null, robotZ = 0;
   var robotAt = null;
 
+  var RTK = ['none', 'float', 'fixed'];
+  var PPS = ['absent', 'synchronizing', 'locked', 'error'];
   function setText(id, text) { document.getElementById(id).textContent = text; }
   function fixed(v, digits) { return v === null || v === undefined ? '–' : Number(v).toFixed(digits); }
 
@@ -282,7 +284,30 @@
     var pose = ['pose (' + s.pose_source + ') ' + (s.pose_valid ? 'valid' : 'NOT valid: ' + s.pose_status)];
     if (s.pose_age_s !== null) pose.push('age ' + fixed(s.pose_age_s, 2) + ' s');
     if (s.fix_type >= 0) pose.push('fix ' + s.fix_type + (s.h_acc_m !== null ? ', hAcc ' + fixed(s.h_acc_m, 2) + ' m' : ''));
+    if (s.rtk_solution >= 0) pose.push('RTK ' + (RTK[s.rtk_solution] || '?'));
     setText('pose', pose.join(' · '));
+    var corrections = [];
+    if (s.corrections) {
+      corrections.push('corrections: ' + s.corrections);
+      corrections.push('age ' + (s.correction_age_s === null ? 'none written' : fixed(s.correction_age_s, 1) + ' s'));
+      if (s.corrections_bytes_per_s !== null) corrections.push(fixed(s.corrections_bytes_per_s, 0) + ' B/s');
+    }
+    setText('corrections', corrections.join(' · '));
+    setText('time', timeText(s));
+  }
+
+  // The time's quality in words: the host clock against GNSS time and against the VLP-16's.
+  function timeText(s) {
+    var ms = function (v) { return (v >= 0 ? '+' : '') + fixed(1000 * v, 1) + ' ms'; };
+    var parts = [];
+    if (s.host_minus_gnss_utc_s !== null) {
+      parts.push('host − GNSS ' + ms(s.host_minus_gnss_utc_s) +
+                 (s.gnss_time_accuracy_s !== null ? ' (tAcc ' + fixed(1e9 * s.gnss_time_accuracy_s, 0) + ' ns)' : ''));
+    }
+    if (s.host_minus_lidar_utc_s !== null) parts.push('host − LiDAR ' + ms(s.host_minus_lidar_utc_s));
+    if (s.lidar_pps_status >= 0) parts.push('LiDAR PPS ' + (PPS[s.lidar_pps_status] || '?'));
+    if (s.lidar_gprmc_valid >= 0) parts.push('GPRMC ' + (s.lidar_gprmc_valid ? 'valid' : 'invalid'));
+    return parts.length ? 'time: ' + parts.join(' · ') : 'time: no GNSS or LiDAR time yet';
   }
 
   function onPose(p) {

@@ -152,7 +152,9 @@ struct DaemonConfig {
   } buffers;
 
   struct Time {
-    double max_gnss_offset_s = 0.1;  // host UTC − GNSS UTC beyond this is warned (NTP/chrony off?)
+    double max_gnss_offset_s = 0.1;   // host UTC − GNSS UTC beyond this is warned (NTP/chrony off?)
+    double max_lidar_offset_s = 0.1;  // host UTC − the VLP-16's PPS-locked UTC beyond this is warned
+    std::optional<int> chrony_shm;    // GNSS time to chrony's `refclock SHM N` (none: off)
   } time;
 
   struct Logging {
