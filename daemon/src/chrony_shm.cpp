@@ -50,7 +50,8 @@ std::string ChronyShm::attach() {
              std::to_string(unit_) + "` in its configuration (chronyd makes the segment; start it first)?";
     }
     if (e == EACCES) {
-      return "segment " + std::string(key_text) + " is not ours to write (chronyd makes SHM 0 and 1 root-only): use "
+      return "segment " + std::string(key_text) +
+             " is not ours to write (chronyd makes SHM 0 and 1 root-only): use "
              "`refclock SHM 2` and time.chrony_shm: 2";
     }
     if (e == EINVAL) return "segment " + std::string(key_text) + " is smaller than an NTP SHM segment: not chrony's?";

@@ -120,6 +120,8 @@ std::vector<ConfigKey> make_keys() {
                "gate: at least this RTK carrier solution (NAV-PVT carrSoln; needs corrections: gnss.corrections)",
                false,
                [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
+                 if (m.has("require_rtk_fixed"))  // the boolean this key replaced
+                   m.fail("require_rtk_fixed", "renamed: pose.require_rtk: fixed (or float, none)");
                  const std::string s =
                      m.choice(key, {"none", "float", "fixed"}, std::string(pose::to_string(c.gate.require_rtk)));
                  c.gate.require_rtk = s == "fixed"   ? pose::RtkSolution::kFixed

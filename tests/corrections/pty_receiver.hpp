@@ -50,7 +50,8 @@ class Receiver {
       if (at + 6 > log.size()) break;
       const std::size_t length = static_cast<std::uint8_t>(log[at + 4]) | static_cast<std::uint8_t>(log[at + 5]) << 8;
       const std::size_t end = std::min(log.size(), at + 8 + length);
-      epochs_.emplace_back(log.begin() + static_cast<std::ptrdiff_t>(from), log.begin() + static_cast<std::ptrdiff_t>(end));
+      epochs_.emplace_back(log.begin() + static_cast<std::ptrdiff_t>(from),
+                           log.begin() + static_cast<std::ptrdiff_t>(end));
       from = end;
     }
     thread_ = std::thread([this] { serve(); });

@@ -58,7 +58,8 @@ TEST(TrajroidChrony, ChronydReadsTheGnssTimeTrajroidWrites) {
   std::ofstream(dir / "chrony.conf") << "refclock SHM " << kUnit << ":perm=0666 refid GNSS poll 0 filter 3\n"
                                      << "pidfile " << (dir / "chronyd.pid").string() << "\n";
   const fs::path chrony_log = dir / "chronyd.log";
-  Child chronyd(chronyd_program, {"-Q", "-d", "-t", "40", "-u", "root", "-f", (dir / "chrony.conf").string()}, chrony_log);
+  Child chronyd(chronyd_program, {"-Q", "-d", "-t", "40", "-u", "root", "-f", (dir / "chrony.conf").string()},
+                chrony_log);
   for (int i = 0; i < 100 && !segment_exists(); ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   ASSERT_TRUE(segment_exists()) << daemon_test::slurp(chrony_log);
@@ -74,8 +75,8 @@ TEST(TrajroidChrony, ChronydReadsTheGnssTimeTrajroidWrites) {
       << "pose:\n  source: gnss\n  gnss_heading: {initial_heading_deg: 90}\n"
       << "time:\n  chrony_shm: " << kUnit << "\n"
       << "lcm:\n  channels: {points: " << prefix << "_POINTS, pose: " << prefix << "_POSE, roi: " << prefix
-      << "_ROI, status: " << prefix << "_STATUS, trajectory: " << prefix << "_TRAJECTORY, active_trajectory: "
-      << prefix << "_ACTIVE}\n";
+      << "_ROI, status: " << prefix << "_STATUS, trajectory: " << prefix << "_TRAJECTORY, active_trajectory: " << prefix
+      << "_ACTIVE}\n";
   Listener listener(prefix);
   const fs::path log = dir / "trajroid.log";
   Child trajroid({"--config", (dir / "trajroid.yaml").string(), "--lcm-url", daemon_test::kTestLcmUrl}, log);
@@ -101,8 +102,8 @@ TEST(TrajroidChrony, ChronydReadsTheGnssTimeTrajroidWrites) {
     // trajroid's status maps each epoch at the least latency seen; chronyd has the raw receive
     // times of a pseudo-terminal: the same within a few milliseconds.
     EXPECT_NEAR(chrony_offset, -host_minus_gnss, 0.05) << said;
-    std::cout << std::fixed << std::setprecision(4) << "chronyd: system clock wrong by " << chrony_offset << " s; trajroid: host − GNSS UTC "
-              << host_minus_gnss << " s\n";
+    std::cout << std::fixed << std::setprecision(4) << "chronyd: system clock wrong by " << chrony_offset
+              << " s; trajroid: host − GNSS UTC " << host_minus_gnss << " s\n";
   }
   trajroid.signal(SIGTERM);
   EXPECT_EQ(trajroid.wait(std::chrono::seconds(10)), 0) << daemon_test::slurp(log);

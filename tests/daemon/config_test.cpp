@@ -76,6 +76,13 @@ TEST(DaemonConfig, MistakesAreNamedByFileLineKeyAndValue) {
       error_of(replaced(example(), "  spacing_ratio: 0.25", "  spacing_ratio: 0.000001")).find("roi.spacing_ratio"),
       std::string::npos);
   EXPECT_NE(error_of(replaced(example(), "global_frame:", "global_fram:")).find("global_frame"), std::string::npos);
+  const std::string renamed = error_of(replaced(example(), "  max_h_acc_m: 5.0", "  require_rtk_fixed: true"));
+  EXPECT_NE(renamed.find("pose.require_rtk_fixed: renamed: pose.require_rtk: fixed (or float, none)"),
+            std::string::npos)
+      << renamed;
+  EXPECT_NE(error_of(replaced(example(), "  chrony_shm: none", "  chrony_shm: 2.5"))
+                .find("time.chrony_shm: must be none or an SHM unit 0 … 15"),
+            std::string::npos);
 }
 
 // The documented defaults are the code's: the example (every key, "with the value the daemon
