@@ -48,7 +48,8 @@ class Receiver {
     for (std::size_t at = log.find("\xB5\x62\x01\x07"); at != std::string::npos;
          at = log.find("\xB5\x62\x01\x07", at + 4)) {
       if (at + 6 > log.size()) break;
-      const std::size_t length = static_cast<std::uint8_t>(log[at + 4]) | static_cast<std::uint8_t>(log[at + 5]) << 8;
+      const std::size_t length = static_cast<std::size_t>(static_cast<std::uint8_t>(log[at + 4]) |
+                                                          static_cast<std::uint8_t>(log[at + 5]) << 8);
       const std::size_t end = std::min(log.size(), at + 8 + length);
       epochs_.emplace_back(log.begin() + static_cast<std::ptrdiff_t>(from),
                            log.begin() + static_cast<std::ptrdiff_t>(end));
