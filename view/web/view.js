@@ -298,7 +298,9 @@
 
   // The time's quality in words: the host clock against GNSS time and against the VLP-16's.
   function timeText(s) {
-    var ms = function (v) { return (v >= 0 ? '+' : '') + fixed(1000 * v, 1) + ' ms'; };
+    var ms = function (v) {
+      return (v >= 0 ? '+' : '') + (Math.abs(v) >= 10 ? fixed(v, 1) + ' s' : fixed(1000 * v, 1) + ' ms');
+    };
     var parts = [];
     if (s.host_minus_gnss_utc_s !== null) {
       parts.push('host − GNSS ' + ms(s.host_minus_gnss_utc_s) +
