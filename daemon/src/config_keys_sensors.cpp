@@ -109,10 +109,15 @@ void add_sensor_keys(std::vector<ConfigKey>& k) {
                [](const DaemonConfig& c) { return std::string(coordinates_text(c.trajectory_coordinates)); }});
   // ---- lidar
   k.push_back(
-      {"lidar.model", "VLP-16", "the only model decoded; HDL-32E and VLP-32C packets are rejected (counted)", false,
-       [](MapReader& m, std::string_view key, DaemonConfig&, const Dir&) { (void)m.choice(key, {"VLP-16"}, "VLP-16"); },
-       [](const DaemonConfig&) { return std::string("VLP-16"); }});
-  k.push_back({"lidar.calibration", "path", "velodyne/nebula calibration YAML; empty: the VLP-16 manual's angles",
+      {"lidar.model", "auto | vlp16 | puck_lite | puck_hires | vlp32c | hdl32e",
+       "auto: told from the packets' product id; a model: other models' packets are dropped and named", false,
+       [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
+         c.lidar.model = m.choice(key, {"auto", "vlp16", "puck_lite", "puck_hires", "vlp32c", "hdl32e"}, c.lidar.model);
+       },
+       [](const DaemonConfig& c) { return c.lidar.model; }});
+  k.push_back({"lidar.calibration", "path",
+               "velodyne/nebula calibration YAML (16 or 32 lasers) for lidar.model (auto: 16 lasers, a VLP-16); "
+               "empty: the model's manual values",
                false,
                [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir& dir) {
                  c.lidar.calibration = resolve(dir, m.text(key, c.lidar.calibration.string()));

@@ -7,6 +7,7 @@
 
 #include "health_format.hpp"
 #include "trajroi/pipeline/pose_words.hpp"
+#include "trajroi/vlp16/model.hpp"
 #include "trajroi/vlp16/packet.hpp"
 #include "trajroi/vlp16/position.hpp"
 
@@ -150,14 +151,26 @@ void HealthMonitor::lidar(const StatusSnapshot& s, std::vector<HealthLine>& out)
           static_cast<unsigned long long>(not_vlp16), window, l.data_port, s.foreign_min_size, s.foreign_max_size,
           sender_list(s).c_str()),
       sprintf_text("lidar: VLP-16 packets arriving on UDP port %u", l.data_port), out);
+  // The model the packets are decoded as, said once (and again should it ever change).
+  if (s.lidar_model >= 0 && s.lidar_model != lidar_model_said_) {
+    const vlp16::ModelSpec& m = vlp16::spec(static_cast<vlp16::Model>(s.lidar_model));
+    out.push_back({HealthLine::Level::kInfo,
+                   sprintf_text("lidar: %s packets (product id 0x%02X), decoded with %s (lidar.model %s)",
+                                std::string(m.name).c_str(), static_cast<unsigned>(m.product_id),
+                                l.calibration.empty() ? "its manual's geometry"
+                                                      : ("lidar.calibration " + l.calibration.string()).c_str(),
+                                l.model.c_str())});
+    lidar_model_said_ = s.lidar_model;
+  }
   const auto unsupported = [](const StatusSnapshot& x) { return rejected(x, vlp16::PacketError::kUnsupportedProduct); };
   if (const std::uint64_t n = unsupported(s) - unsupported(previous); n > 0) {
     const std::string reason = s.model_reason.data();
     out.push_back(
         {HealthLine::Level::kWarning,
-         sprintf_text("lidar: %llu packets rejected in the last second: %s (trajroid decodes the VLP-16 only; "
-                      "lidar.rejected.unsupported_product %llu)",
-                      static_cast<unsigned long long>(n), reason.empty() ? "not a VLP-16" : reason.c_str(),
+         sprintf_text("lidar: %llu packets rejected in the last second: %s (trajroid decodes the VLP-16, Puck LITE, "
+                      "Puck Hi-Res, VLP-32C and HDL-32E; lidar.rejected.unsupported_product %llu)",
+                      static_cast<unsigned long long>(n),
+                      reason.empty() ? "not a model trajroid decodes" : reason.c_str(),
                       static_cast<unsigned long long>(unsupported(s)))});
   }
   if (const std::uint64_t n = s[C::kLidarClockJumps] - previous[C::kLidarClockJumps]; n > 0) {

@@ -85,6 +85,7 @@ class HealthMonitor {
   std::deque<StatusSnapshot> history_;  // oldest first; the first is the all-zero start
   bool active_[kFaultCount] = {};
   bool lidar_pps_locked_once_ = false;
+  std::int8_t lidar_model_said_ = -1;
   // Each serial port's fault in a few words for the state ("NMEA text, no UBX"): GNSS, IMU.
   std::string serial_state_[2];
   StatusSnapshot minute_start_;  // the mixed LiDAR port's summary

@@ -41,7 +41,7 @@ bool wake_now(const inputs::InputItem& item, std::uint16_t cut_cdeg, std::uint16
 // says why), nor when that ring is full (the processing thread then decodes it itself: the same
 // points either way).
 bool decode_ahead(const Pipeline& pipeline, InputLane& lane, const InputSlot& slot) {
-  if (slot.stream != inputs::Stream::kLidarData || pipeline.lidar_decoder == nullptr || !lane.decoded) return false;
+  if (slot.stream != inputs::Stream::kLidarData || pipeline.lidar_stream == nullptr || !lane.decoded) return false;
   // Only while the processing thread is behind (busy, and items wait in the ring; items this
   // thread holds back while it sleeps do not count): otherwise it decodes the packet itself, as
   // at real time, where decoding ahead would only add the copy between the cores. The work goes
@@ -50,10 +50,13 @@ bool decode_ahead(const Pipeline& pipeline, InputLane& lane, const InputSlot& sl
   if (pipeline.processing_waits.load(std::memory_order_relaxed) || lane.ring->size() < backlog) return false;
   const std::span<const std::uint8_t> packet(slot.bytes.data(), slot.size);
   if (vlp16::validate_data_packet(packet) != vlp16::PacketError::kNone) return false;
+  const vlp16::PacketDecoder* decoder = pipeline.lidar_stream->decoder_for(packet);
+  if (decoder == nullptr) return false;
   return lane.decoded->try_push([&](vlp16::DecodedPacket& d) {
     d.tag = slot.seq;
+    d.model = decoder->model();
     d.points.clear();
-    d.result = pipeline.lidar_decoder->decode(packet, d.points);
+    d.result = decoder->decode(packet, d.points);
   });
 }
 

@@ -164,9 +164,10 @@ struct Pipeline {
 
   const DaemonConfig& config;
   const bool exact;
-  // The processor's packet decoder (SweepProcessor::packet_decoder()), set before the threads
-  // start: the input threads decode LiDAR data packets ahead with it, on their own core.
-  const vlp16::PacketDecoder* lidar_decoder = nullptr;
+  // The processor's LiDAR stream (SweepProcessor::lidar_stream()), set before the threads
+  // start: the input threads decode LiDAR data packets ahead with its decoders
+  // (StreamDecoder::decoder_for), on their own core.
+  const vlp16::StreamDecoder* lidar_stream = nullptr;
   std::atomic<bool> stop{false};
   std::atomic<std::uint64_t> sequence{0};
   EventFd process_wake, publish_wake, record_wake, main_wake;

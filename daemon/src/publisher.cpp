@@ -10,6 +10,7 @@
 #include "trajroi/host/clock.hpp"
 #include "trajroi/pipeline/pose_words.hpp"
 #include "trajroi/status_t.hpp"
+#include "trajroi/vlp16/model.hpp"
 
 namespace trajroi::daemon {
 
@@ -112,6 +113,7 @@ void Publisher::publish_status(const StatusSnapshot& s) {
   m.host_minus_lidar_utc_s = s.host_minus_lidar_utc_s;
   m.rtk_solution = gnss ? s.rtk : std::int8_t{-1};
   m.lidar_pps_status = s.lidar_pps_status;
+  m.lidar_model = s.lidar_model >= 0 ? std::string(vlp16::to_string(static_cast<vlp16::Model>(s.lidar_model))) : "";
   m.lidar_gprmc_valid = s.lidar_gprmc_valid;
   m.processing_ms_p50 = latency_.window_processing_ms(0.50);
   m.processing_ms_p99 = latency_.window_processing_ms(0.99);

@@ -94,6 +94,8 @@ void fill_snapshot(const pipeline::SweepProcessor& p, const Pipeline& pipeline, 
   } else {
     s.rtk = -1;
   }
+  const vlp16::ModelCheck& model = p.lidar_stream().model_check();
+  s.lidar_model = model.decided() ? static_cast<std::int8_t>(model.model()) : std::int8_t{-1};
   const auto& position = p.lidar_position();
   s.lidar_pps_status = position ? static_cast<std::int8_t>(position->pps) : std::int8_t{-1};
   s.lidar_gprmc_valid = !position || position->nmea != vlp16::NmeaError::kNone ? std::int8_t{-1}

@@ -127,9 +127,10 @@ struct StatusSnapshot {
   double host_minus_gnss_utc_s = 0.0;   // NaN: unknown
   double gnss_time_accuracy_s = 0.0;    // its NAV-PVT tAcc (NaN: unknown)
   double host_minus_lidar_utc_s = 0.0;  // host UTC − the VLP-16's PPS-locked UTC (NaN: unknown)
+  std::int8_t lidar_model = -1;         // vlp16::Model of the packets decoded, -1: none yet
   std::int8_t lidar_pps_status = -1;    // vlp16::PpsStatus of the newest position packet, -1: none
   std::int8_t lidar_gprmc_valid = -1;   // its RMC: 1 valid, 0 not, -1 none
-  std::array<char, 160> model_reason{};
+  std::array<char, 256> model_reason{};
   std::array<std::uint64_t, kCounterCount> counters{};
 
   [[nodiscard]] std::uint64_t& operator[](Counter c) noexcept { return counters[static_cast<std::size_t>(c)]; }

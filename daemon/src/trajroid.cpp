@@ -179,7 +179,7 @@ int run_pipeline(Pipeline& pipeline, pipeline::SweepProcessor& processor, Outlet
                  bool signals) {
   const std::int64_t start_ns = host::monotonic_ns();
   const int sfd = signals ? block_signals() : -1;
-  pipeline.lidar_decoder = &processor.packet_decoder();  // the input threads decode ahead with it
+  pipeline.lidar_stream = &processor.lidar_stream();  // the input threads decode ahead with its decoders
   Reloader reloader(TrajectorySource::from(pipeline.config), pipeline.publish_wake);
   Publisher publisher(pipeline, outlet, &reloader, options.replay.has_value(), processor.active_trajectory());
   ProcessingOptions processing;

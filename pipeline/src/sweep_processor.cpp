@@ -8,6 +8,7 @@
 
 #include "processor_constants.hpp"
 #include "trajroi/config/text_file.hpp"
+#include "trajroi/config/yaml_reader.hpp"
 #include "trajroi/framing/little_endian.hpp"
 #include "trajroi/pose_input_t.hpp"
 
@@ -31,12 +32,28 @@ double size_along(const DaemonConfig::Roi& r) {
 
 vlp16::Calibration load_calibration(const DaemonConfig& c) {
   const std::filesystem::path& file = c.lidar.calibration;
-  if (file.empty()) return vlp16::Calibration::vlp16_default();
-  return vlp16::parse_calibration_yaml(config::read_text_file(file), file.string());
+  const std::optional<vlp16::Model> model = vlp16::model_named(c.lidar.model);
+  if (file.empty()) return vlp16::Calibration::for_model(model.value_or(vlp16::Model::kVlp16));
+  vlp16::Calibration calibration = vlp16::parse_calibration_yaml(config::read_text_file(file), file.string());
+  const vlp16::ModelSpec& s = vlp16::spec(model.value_or(vlp16::Model::kVlp16));
+  if (!model && calibration.laser_count != s.lasers) {
+    throw config::ConfigError("lidar.calibration " + file.string() + ": " + std::to_string(calibration.laser_count) +
+                              " lasers: set lidar.model (vlp32c or hdl32e) for a 32-laser calibration");
+  }
+  if (calibration.laser_count != s.lasers) {
+    throw config::ConfigError("lidar.calibration " + file.string() + ": " + std::to_string(calibration.laser_count) +
+                              " lasers, but a " + std::string(s.name) + " (lidar.model " + c.lidar.model + ") has " +
+                              std::to_string(s.lasers));
+  }
+  return calibration;
 }
 
 vlp16::StreamOptions stream_options(const DaemonConfig& c) {
   vlp16::StreamOptions o;
+  // A model named, or told from the packets; a calibration file without a model is a VLP-16's.
+  const std::optional<vlp16::Model> model = vlp16::model_named(c.lidar.model);
+  o.model = model.value_or(vlp16::Model::kVlp16);
+  o.detect_model = !model && c.lidar.calibration.empty();
   o.decode.min_range_m = c.lidar.min_range_m;
   o.decode.max_range_m = c.lidar.max_range_m;
   o.cut_azimuth_deg = c.lidar.cut_azimuth_deg;

@@ -238,14 +238,28 @@ TEST(LiveFaults, BytesThatNeverFrameSayWrongBaudRate) {
   rig.stop(daemon);
 }
 
-TEST(LiveFaults, AnotherLidarModelIsNamedWithTheDriversReason) {
+TEST(LiveFaults, AnotherLidarModelThanConfiguredIsNamedWithTheDriversReason) {
   TRAJROI_REQUIRE_DATA(hdl32e, "velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap");
-  const Rig rig("model", "fixed", 7);
+  const Rig rig("model", "fixed", 7, "  model: vlp16\n");
   const auto start = std::chrono::steady_clock::now();
   Child daemon(rig.daemon_args(), rig.daemon_log);
   Child feeder(TRAJROI_CLI, rig.pcap_feed(hdl32e, "0.5"), rig.feed_log);
-  EXPECT_LOGGED_WITHIN_5S(rig, "(HDL-32E) is not supported", start);
-  EXPECT_LOGGED_WITHIN_5S(rig, "trajroid decodes the VLP-16 only", start);
+  EXPECT_LOGGED_WITHIN_5S(rig,
+                          "(HDL-32E) sends HDL-32E packets (told by its timing: 553 µs between packets), but "
+                          "lidar.model is vlp16: dropped (set lidar.model: hdl32e, or auto)",
+                          start);
+  rig.stop(daemon);
+}
+
+// lidar.model auto (the default): the HDL-32E's packets are decoded, the model said.
+TEST(LiveCaptures, AnHdl32eIsToldFromItsPacketsAndDecoded) {
+  TRAJROI_REQUIRE_DATA(hdl32e, "velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap");
+  const Rig rig("hdl32e", "fixed", 16);
+  const auto start = std::chrono::steady_clock::now();
+  Child daemon(rig.daemon_args(), rig.daemon_log);
+  Child feeder(TRAJROI_CLI, rig.pcap_feed(hdl32e, "0.5"), rig.feed_log);
+  EXPECT_LOGGED_WITHIN_5S(
+      rig, "lidar: HDL-32E packets (product id 0x21), decoded with its manual's geometry (lidar.model auto)", start);
   rig.stop(daemon);
 }
 

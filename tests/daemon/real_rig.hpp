@@ -42,7 +42,7 @@ struct Rig {
     prefix = "TRJREAL_" + std::to_string(pid) + "_" + name;
     dir = fs::temp_directory_path() / ("trajroid_real_" + name + "_" + std::to_string(pid));
     fs::create_directories(dir);
-    data_port = 24000 + (pid % 1000) * 32 + port_offset * 2;  // offsets 0 … 15
+    data_port = 24000 + (pid % 1000) * 40 + port_offset * 2;  // offsets 0 … 19
     gnss_link = dir / "gnss";
     imu_link = dir / "imu";
     daemon_log = dir / "trajroid.log";

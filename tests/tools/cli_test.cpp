@@ -147,17 +147,30 @@ TEST_F(Cli, LidarDumpReportsTheMrptCapture) {
 
 TEST_F(Cli, LidarDumpNamesTheRejectedModel) {
   TRAJROI_REQUIRE_DATA(capture, "velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap");
-  const CommandResult r = run("lidar-dump --json " + capture.string());
+  const CommandResult r = run("lidar-dump --model vlp16 --json " + capture.string());
   // The report, then a failure that says nothing could be decoded.
   EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_NE(r.err.find("no VLP-16 data packet could be decoded: all 500 data packets rejected: product id 0x21 "
-                       "(HDL-32E) is not supported"),
+  EXPECT_NE(r.err.find("no data packet could be decoded: all 500 data packets rejected: product id 0x21 "
+                       "(HDL-32E) sends HDL-32E packets (told by its timing: 553 µs between packets), but "
+                       "lidar.model is vlp16"),
             std::string::npos)
       << r.err;
   EXPECT_NE(r.out.find("\"unsupported_product\": 500}"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("\"model\": \"HDL-32E\""), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("product id 0x21 (HDL-32E) is not supported"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("\"points\": 0,"), std::string::npos) << r.out;
+}
+
+// Without --model the model is the packets': the HDL-32E capture decodes, and says so.
+TEST_F(Cli, LidarDumpReportsTheModelItFound) {
+  TRAJROI_REQUIRE_DATA(hdl32e, "velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap");
+  TRAJROI_REQUIRE_DATA(vlp32c, "velodyne/other_models/nebula_vlp32c_strongest_1713492677.DERIVED.pcap");
+  const CommandResult a = run("lidar-dump " + hdl32e.string());
+  EXPECT_EQ(a.exit_code, 0) << a.err;
+  EXPECT_NE(a.out.find("model             HDL-32E (product id 0x21)"), std::string::npos) << a.out;
+  EXPECT_NE(a.out.find("500 decoded, 0 rejected"), std::string::npos) << a.out;
+  const CommandResult b = run("lidar-dump --json " + vlp32c.string());
+  EXPECT_EQ(b.exit_code, 0) << b.err;
+  EXPECT_NE(b.out.find("\"model\": \"VLP-32C\""), std::string::npos) << b.out;
 }
 
 TEST_F(Cli, LidarDumpOfATruncatedCaptureReportsWhatItReadThenFails) {
@@ -179,7 +192,7 @@ TEST_F(Cli, LidarDumpRejectsAMissingFileAndABadCalibration) {
   const fs::path pcap = write("empty.pcap", "");
   r = run("lidar-dump " + pcap.string() + " --calibration " + yaml.string());
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("bad.yaml: 'lasers' has 1 entries; a VLP-16 has 16"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("'lasers' has 1 entries; the models trajroi decodes have 16"), std::string::npos) << r.err;
 }
 
 }  // namespace

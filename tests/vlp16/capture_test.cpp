@@ -203,11 +203,13 @@ TEST_P(Vlp16RejectsOtherModels, EveryPacketRejectedWithTheReason) {
 INSTANTIATE_TEST_SUITE_P(
     Captures, Vlp16RejectsOtherModels,
     testing::Values(RejectedCapture{"velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap", 500,
-                                    "product id 0x21 (HDL-32E) is not supported: 553 µs between packets"},
+                                    "product id 0x21 (HDL-32E) sends HDL-32E packets (told by its timing: 553 µs "
+                                    "between packets), but lidar.model is vlp16: dropped (set lidar.model: hdl32e, "
+                                    "or auto)"},
                     RejectedCapture{"velodyne/other_models/rust-lidar-utils_velodyne_vlp32_ACTUALLY_HDL-32E.pcap", 91,
-                                    "product id 0x21 (HDL-32E) is not supported"},
+                                    "product id 0x21 (HDL-32E) sends HDL-32E packets"},
                     RejectedCapture{"velodyne/other_models/nebula_vlp32c_strongest_1713492677.DERIVED.pcap", 379,
-                                    "product id 0x28 (VLP-32C) is not supported"}));
+                                    "product id 0x28 (VLP-32C) sends VLP-32C packets, but lidar.model is vlp16"}));
 
 // The reader thread's early wake-up: every whole frame the decoder completes on a real capture
 // is completed by a packet may_complete_frame foresaw, at cuts all round; and it foresees few

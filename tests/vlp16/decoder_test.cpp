@@ -44,9 +44,11 @@ TEST(Vlp16Packet, EveryRejectionReason) {
   auto mode = good;
   mode[1204] = 0x3A;
   EXPECT_EQ(validate_data_packet(mode), PacketError::kUnknownReturnMode);
-  const auto vlp32c = make_packet(0, 40, ReturnMode::kStrongest, 0x28);
-  EXPECT_EQ(validate_data_packet(vlp32c), PacketError::kUnsupportedProduct);
-  EXPECT_EQ(product_name(0x28), "VLP-32C");
+  const auto vls128 = make_packet(0, 40, ReturnMode::kStrongest, 0xA1);
+  EXPECT_EQ(validate_data_packet(vls128), PacketError::kUnsupportedProduct);
+  EXPECT_EQ(product_name(0xA1), "VLS-128");
+  for (const std::uint8_t id : {kProductHdl32e, kProductVlp16, kProductPuckHiRes, kProductVlp32c})  // decoded
+    EXPECT_EQ(validate_data_packet(make_packet(0, 40, ReturnMode::kStrongest, id)), PacketError::kNone) << int{id};
   // 0x21 passes validation: whether it is an early VLP-16 is decided from the timing.
   EXPECT_EQ(validate_data_packet(make_packet(0, 40, ReturnMode::kStrongest, 0x21)), PacketError::kNone);
   EXPECT_EQ(to_string(PacketError::kBadBlockFlag), "bad_block_flag");
@@ -292,17 +294,20 @@ TEST(Vlp16Calibration, BadFilesNameTheProblem) {
     }
     return std::string("(accepted)");
   };
-  EXPECT_EQ(message(kTwoLasers), "cal.yaml: 'lasers' has 2 entries; a VLP-16 has 16");
+  EXPECT_EQ(message(kTwoLasers),
+            "cal.yaml:2: 'lasers' has 2 entries; the models trajroi decodes have 16 (VLP-16, Puck LITE, Puck Hi-Res) "
+            "or 32 (VLP-32C, HDL-32E)");
   EXPECT_EQ(message("foo: 1\n"), "cal.yaml: no 'lasers' list");
   EXPECT_NE(message("lasers: [\n").find("cal.yaml: line"), std::string::npos);
-  EXPECT_EQ(message(sixteen_lasers("  - {laser_id: 3, vert_correction: 0.1}\n")), "cal.yaml: laser_id 3 appears twice");
-  EXPECT_EQ(message(sixteen_lasers("  - {laser_id: 7}\n")), "cal.yaml: laser entry 7 has no 'vert_correction'");
+  EXPECT_EQ(message(sixteen_lasers("  - {laser_id: 3, vert_correction: 0.1}\n")),
+            "cal.yaml:9: laser_id 3 appears twice");
+  EXPECT_EQ(message(sixteen_lasers("  - {laser_id: 7}\n")), "cal.yaml:9: laser entry 7 has no 'vert_correction'");
   EXPECT_EQ(message(sixteen_lasers("  - {laser_id: 7, vert_correction: abc}\n")),
-            "cal.yaml: laser entry 7: 'vert_correction' is not a number");
+            "cal.yaml:9: laser entry 7: 'vert_correction' is not a number");
   EXPECT_EQ(message(sixteen_lasers("  - {laser_id: 16, vert_correction: 0.1}\n")),
-            "cal.yaml: laser entry 7: laser_id 16.000000 is not 0 … 15");
+            "cal.yaml:9: laser entry 7: laser_id 16.000000 is not 0 … 15");
   EXPECT_EQ(message(sixteen_lasers("  - {laser_id: 7, vert_correction: 15}\n")),
-            "cal.yaml: laser_id 7: vert_correction is not an angle in radians");
+            "cal.yaml:9: laser_id 7: vert_correction is not an angle in radians");
 }
 
 // Corrections follow the velodyne model: θ = azimuth − rot_correction, range + dist_correction,

@@ -29,6 +29,7 @@ using namespace trajroi::vlp16;
 struct LidarDumpOptions {
   std::string capture;
   std::string calibration;
+  std::string model = "auto";
   std::string points_csv;
   bool json = false;
   double min_range_m = 0.0;
@@ -120,9 +121,20 @@ std::string return_mode_name(std::optional<ReturnMode> mode) {
 }
 
 void run_lidar_dump(const LidarDumpOptions& o) {
-  Calibration calibration = Calibration::vlp16_default();
-  if (!o.calibration.empty()) calibration = parse_calibration_yaml(read_text_file(o.calibration), o.calibration);
+  const std::optional<Model> named = model_named(o.model);
+  Calibration calibration = Calibration::for_model(named.value_or(Model::kVlp16));
+  if (!o.calibration.empty()) {
+    calibration = parse_calibration_yaml(read_text_file(o.calibration), o.calibration);
+    const ModelSpec& s = spec(named.value_or(Model::kVlp16));
+    if (calibration.laser_count != s.lasers) {
+      throw std::runtime_error(o.calibration + ": " + std::to_string(calibration.laser_count) + " lasers, but a " +
+                               std::string(s.name) + " has " + std::to_string(s.lasers) +
+                               (named ? "" : " (--model for a 32-laser calibration: vlp32c or hdl32e)"));
+    }
+  }
   StreamOptions options;
+  options.model = named.value_or(Model::kVlp16);
+  options.detect_model = !named && o.calibration.empty();
   options.decode.min_range_m = o.min_range_m;
   options.decode.max_range_m = o.max_range_m;
   options.cut_azimuth_deg = o.cut_azimuth_deg;
@@ -155,7 +167,9 @@ void run_lidar_dump(const LidarDumpOptions& o) {
                 return a.second < b.second;
               })->first;
   }
-  const std::string model = c.decoded_packets > 0 ? "VLP-16" : product ? std::string(product_name(*product)) : "";
+  const std::string model = c.decoded_packets > 0 ? std::string(to_string(decoder.model_check().model()))
+                            : product             ? std::string(product_name(*product))
+                                                  : "";
 
   if (o.json) {
     std::string rejected = "{";
@@ -215,7 +229,7 @@ void run_lidar_dump(const LidarDumpOptions& o) {
         : !decoder.model_check().reason().empty()
             ? "all " + std::to_string(c.data_packets) + " data packets rejected: " + decoder.model_check().reason()
             : "all " + std::to_string(c.data_packets) + " data packets rejected (see the counts above)";
-    throw std::runtime_error(o.capture + ": no VLP-16 data packet could be decoded: " + why);
+    throw std::runtime_error(o.capture + ": no data packet could be decoded: " + why);
   }
 }
 
@@ -223,11 +237,16 @@ void run_lidar_dump(const LidarDumpOptions& o) {
 
 void add_lidar_dump_command(CLI::App& app) {
   auto o = std::make_shared<LidarDumpOptions>();
-  CLI::App* cmd = app.add_subcommand("lidar-dump", "Decode a VLP-16 pcap capture and report what it holds");
+  CLI::App* cmd = app.add_subcommand("lidar-dump",
+                                     "Decode a Velodyne pcap capture (VLP-16, Puck LITE / Hi-Res, VLP-32C, HDL-32E) "
+                                     "and report what it holds, the model first");
   cmd->add_option("capture", o->capture, "pcap file (Ethernet, VLAN, Linux SLL/SLL2 or raw IPv4)")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("--calibration", o->calibration, "velodyne/nebula calibration YAML (default: the VLP-16 manual's)")
+  cmd->add_option("--model", o->model, "auto (from the packets' product id) or the sensor's model")
+      ->check(CLI::IsMember({"auto", "vlp16", "puck_lite", "puck_hires", "vlp32c", "hdl32e"}));
+  cmd->add_option("--calibration", o->calibration,
+                  "velodyne/nebula calibration YAML for --model (default: the model's manual values)")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--json", o->json, "print one JSON object");
   cmd->add_option("--points", o->points_csv,

@@ -16,20 +16,27 @@ namespace {
   throw std::runtime_error(std::string(source) + ": " + what);
 }
 
+// "source:LINE" for a node (yaml-cpp counts lines from 0).
+std::string at(std::string_view source, const YAML::Node& node) {
+  return std::string(source) + ":" + std::to_string(node.Mark().line + 1);
+}
+
 double read_number(const YAML::Node& laser, const char* key, std::string_view source, std::size_t index,
                    bool required) {
   const YAML::Node value = laser[key];
   if (!value) {
-    if (required) fail(source, "laser entry " + std::to_string(index) + " has no '" + key + "'");
+    if (required) fail(at(source, laser), "laser entry " + std::to_string(index) + " has no '" + key + "'");
     return 0.0;
   }
   double number = 0.0;
   try {
     number = value.as<double>();
   } catch (const YAML::Exception&) {
-    fail(source, "laser entry " + std::to_string(index) + ": '" + key + "' is not a number");
+    fail(at(source, value), "laser entry " + std::to_string(index) + ": '" + key + "' is not a number");
   }
-  if (!std::isfinite(number)) fail(source, "laser entry " + std::to_string(index) + ": '" + key + "' is not finite");
+  if (!std::isfinite(number)) {
+    fail(at(source, value), "laser entry " + std::to_string(index) + ": '" + key + "' is not finite");
+  }
   return number;
 }
 
@@ -44,25 +51,41 @@ Calibration parse_calibration_yaml(std::string_view text, std::string_view sourc
   }
   const YAML::Node lasers = root["lasers"];
   if (!lasers || !lasers.IsSequence()) fail(source, "no 'lasers' list");
-  if (lasers.size() != kLasers) {
-    fail(source, "'lasers' has " + std::to_string(lasers.size()) + " entries; a VLP-16 has 16");
+  const std::size_t n = lasers.size();
+  if (n != 16 && n != kMaxLasers) {
+    fail(at(source, lasers), "'lasers' has " + std::to_string(n) + " entries; the models trajroi decodes have 16 " +
+                                 "(VLP-16, Puck LITE, Puck Hi-Res) or 32 (VLP-32C, HDL-32E)");
+  }
+  if (const YAML::Node count = root["num_lasers"]) {
+    double declared = 0.0;
+    try {
+      declared = count.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(at(source, count), "'num_lasers' is not a number");
+    }
+    if (declared != static_cast<double>(n)) {
+      fail(at(source, count),
+           "'num_lasers' says " + count.as<std::string>() + " but 'lasers' has " + std::to_string(n) + " entries");
+    }
   }
   Calibration calibration;
-  std::bitset<kLasers> seen;
-  for (std::size_t i = 0; i < lasers.size(); ++i) {
+  calibration.laser_count = n;
+  std::bitset<kMaxLasers> seen;
+  for (std::size_t i = 0; i < n; ++i) {
     const YAML::Node laser = lasers[i];
-    if (!laser.IsMap()) fail(source, "laser entry " + std::to_string(i) + " is not a map");
+    if (!laser.IsMap()) fail(at(source, laser), "laser entry " + std::to_string(i) + " is not a map");
     const double id = read_number(laser, "laser_id", source, i, true);
-    if (id < 0 || id >= static_cast<double>(kLasers) || id != std::floor(id)) {
-      fail(source, "laser entry " + std::to_string(i) + ": laser_id " + std::to_string(id) + " is not 0 … 15");
+    if (id < 0 || id >= static_cast<double>(n) || id != std::floor(id)) {
+      fail(at(source, laser), "laser entry " + std::to_string(i) + ": laser_id " + std::to_string(id) + " is not 0 … " +
+                                  std::to_string(n - 1));
     }
     const auto index = static_cast<std::size_t>(id);
-    if (seen[index]) fail(source, "laser_id " + std::to_string(index) + " appears twice");
+    if (seen[index]) fail(at(source, laser), "laser_id " + std::to_string(index) + " appears twice");
     seen[index] = true;
     LaserCalibration& cal = calibration.lasers[index];
     cal.vert_angle_rad = read_number(laser, "vert_correction", source, i, true);
     if (std::abs(cal.vert_angle_rad) > 0.5 * std::numbers::pi) {
-      fail(source, "laser_id " + std::to_string(index) + ": vert_correction is not an angle in radians");
+      fail(at(source, laser), "laser_id " + std::to_string(index) + ": vert_correction is not an angle in radians");
     }
     cal.rot_correction_rad = read_number(laser, "rot_correction", source, i, false);
     cal.vert_offset_m = read_number(laser, "vert_offset_correction", source, i, false);

@@ -10,6 +10,7 @@
 #endif
 #include <memory>
 #include <numbers>
+#include <stdexcept>
 
 namespace trajroi::vlp16 {
 namespace {
@@ -54,50 +55,86 @@ Calibration Calibration::vlp16_default() {
   return c;
 }
 
-std::array<std::uint8_t, kLasers> Calibration::rings() const {
-  std::array<std::uint8_t, kLasers> order{};
-  for (std::size_t i = 0; i < kLasers; ++i)
+std::array<std::uint8_t, kMaxLasers> Calibration::rings() const {
+  std::array<std::uint8_t, kMaxLasers> order{};
+  for (std::size_t i = 0; i < laser_count; ++i)
     order[i] = static_cast<std::uint8_t>(i);
-  std::stable_sort(order.begin(), order.end(),
+  std::stable_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(laser_count),
                    [&](std::uint8_t a, std::uint8_t b) { return lasers[a].vert_angle_rad < lasers[b].vert_angle_rad; });
-  std::array<std::uint8_t, kLasers> ring{};
-  for (std::size_t rank = 0; rank < kLasers; ++rank)
+  std::array<std::uint8_t, kMaxLasers> ring{};
+  for (std::size_t rank = 0; rank < laser_count; ++rank)
     ring[order[rank]] = static_cast<std::uint8_t>(rank);
   return ring;
 }
 
 // cos and sin computed once per process: of every azimuth the sensor reports (centidegrees),
-// and of the in-block rotation of every channel for every gap the series covers. Each entry is
-// the value decode() would otherwise compute for that block, so decoding is unchanged.
-struct PacketDecoder::AngleTables {
+// and, per model, of the in-block rotation of every channel for every gap the series covers.
+// Each entry is the value decode() would otherwise compute for that block, so decoding is
+// unchanged.
+struct PacketDecoder::AzimuthTable {
   std::array<CosSin, kAzimuthLimit> azimuth;
+};
+struct PacketDecoder::StepTables {
   std::array<std::array<double, kChannels>, kSeriesGapLimit_cdeg + 1> step_cos, step_sin;
 };
 
-const PacketDecoder::AngleTables& PacketDecoder::angle_tables() {
-  static const std::unique_ptr<const AngleTables> tables = [] {
-    auto t = std::make_unique<AngleTables>();
+const PacketDecoder::AzimuthTable& PacketDecoder::azimuth_table() {
+  static const std::unique_ptr<const AzimuthTable> table = [] {
+    auto t = std::make_unique<AzimuthTable>();
     for (std::uint32_t a = 0; a < kAzimuthLimit; ++a) {
       const double rad = static_cast<double>(a) * kCentidegToRad;
       t->azimuth[a] = {std::cos(rad), std::sin(rad)};
     }
+    return std::unique_ptr<const AzimuthTable>(std::move(t));
+  }();
+  return *table;
+}
+
+const PacketDecoder::StepTables& PacketDecoder::step_tables(Model model) {
+  const auto build = [](Model m) {
+    auto t = std::make_unique<StepTables>();
+    const ModelSpec& s = spec(m);
     for (std::uint32_t gap = 0; gap <= kSeriesGapLimit_cdeg; ++gap) {
       const double gap_rad = static_cast<double>(gap) * kCentidegToRad;
       for (std::size_t channel = 0; channel < kChannels; ++channel) {
-        const CosSin s = small_angle(gap_rad * azimuth_fraction(channel));
-        t->step_cos[gap][channel] = s.c;
-        t->step_sin[gap][channel] = s.s;
+        const CosSin c = small_angle(gap_rad * s.azimuth_fraction(channel));
+        t->step_cos[gap][channel] = c.c;
+        t->step_sin[gap][channel] = c.s;
       }
     }
-    return std::unique_ptr<const AngleTables>(std::move(t));
-  }();
-  return *tables;
+    return std::unique_ptr<const StepTables>(std::move(t));
+  };
+  // One table per timing, each built at its first use (thread-safe static initialisation).
+  switch (model) {
+    case Model::kVlp16:
+    case Model::kPuckHiRes: {  // the VLP-16's timing
+      static const auto t = build(Model::kVlp16);
+      return *t;
+    }
+    case Model::kVlp32c: {
+      static const auto t = build(Model::kVlp32c);
+      return *t;
+    }
+    case Model::kHdl32e:
+      break;
+  }
+  static const auto t = build(Model::kHdl32e);
+  return *t;
 }
 
-PacketDecoder::PacketDecoder(const Calibration& calibration, DecodeOptions options)
-    : options_(options), tables_(angle_tables()) {
+PacketDecoder::PacketDecoder(const Calibration& calibration, DecodeOptions options, Model model)
+    : model_(model),
+      options_(options),
+      distance_unit_m_(spec(model).distance_unit_m),
+      azimuth_table_(azimuth_table()),
+      step_tables_(step_tables(model)) {
+  const ModelSpec& s = spec(model);
+  if (calibration.laser_count != s.lasers) {
+    throw std::invalid_argument("a calibration of " + std::to_string(calibration.laser_count) + " lasers for the " +
+                                std::string(s.name) + ", which has " + std::to_string(s.lasers));
+  }
   const auto rings = calibration.rings();
-  for (std::size_t i = 0; i < kLasers; ++i) {
+  for (std::size_t i = 0; i < s.lasers; ++i) {
     const LaserCalibration& cal = calibration.lasers[i];
     lasers_[i] = Laser{std::cos(cal.vert_angle_rad),
                        std::sin(cal.vert_angle_rad),
@@ -111,12 +148,12 @@ PacketDecoder::PacketDecoder(const Calibration& calibration, DecodeOptions optio
     rotation_corrected_ = rotation_corrected_ || cal.rot_correction_rad != 0.0;
   }
   for (std::size_t channel = 0; channel < kChannels; ++channel) {
-    azimuth_fraction_[channel] = azimuth_fraction(channel);
-    const auto in_block_ns = static_cast<std::int64_t>(channel / kLasers) * kFiringCycle_ns +
-                             static_cast<std::int64_t>(channel % kLasers) * kLaserPeriod_ns;
+    channel_laser_[channel] = static_cast<std::uint8_t>(s.laser_of(channel));
+    azimuth_fraction_[channel] = s.azimuth_fraction(channel);
+    const std::int64_t in_block_ns = s.channel_time_ns(channel);
     for (std::size_t pair = 0; pair < kBlocks; ++pair) {
       time_ns_[pair][channel] =
-          static_cast<std::uint32_t>(static_cast<std::int64_t>(pair) * kBlockDuration_ns + in_block_ns);
+          static_cast<std::uint32_t>(static_cast<std::int64_t>(pair) * s.block_duration_ns() + in_block_ns);
     }
   }
 }
@@ -125,9 +162,9 @@ PacketDecoder::PacketDecoder(const Calibration& calibration, DecodeOptions optio
 __attribute__((always_inline)) inline void PacketDecoder::directions(std::uint16_t azimuth, std::uint32_t gap,
                                                                      Directions& d) const noexcept {
   if (gap <= kSeriesGapLimit_cdeg && azimuth < kAzimuthLimit) {
-    const CosSin base = tables_.azimuth[azimuth];
-    const auto& step_cos = tables_.step_cos[gap];
-    const auto& step_sin = tables_.step_sin[gap];
+    const CosSin base = azimuth_table_.azimuth[azimuth];
+    const auto& step_cos = step_tables_.step_cos[gap];
+    const auto& step_sin = step_tables_.step_sin[gap];
     for (std::size_t channel = 0; channel < kChannels; ++channel) {
       d.cos_a[channel] = base.c * step_cos[channel] - base.s * step_sin[channel];
       d.sin_a[channel] = base.s * step_cos[channel] + base.c * step_sin[channel];
@@ -184,7 +221,7 @@ __attribute__((always_inline)) inline void PacketDecoder::directions(std::uint16
 #endif
   if (rotation_corrected_) {  // θ = azimuth − rot_correction
     for (std::size_t channel = 0; channel < kChannels; ++channel) {
-      const Laser& laser = lasers_[channel % kLasers];
+      const Laser& laser = lasers_[channel_laser_[channel]];
       const double c = d.cos_a[channel] * laser.cos_rot + d.sin_a[channel] * laser.sin_rot;
       d.sin_a[channel] = d.sin_a[channel] * laser.cos_rot - d.cos_a[channel] * laser.sin_rot;
       d.cos_a[channel] = c;
@@ -260,12 +297,12 @@ __attribute__((always_inline)) inline PacketDecoder::Result PacketDecoder::decod
   // the decoding's profile samples 83 → 68 ms, medians of 4 runs each; the same points).
   for (std::size_t block = 0; block < kBlocks; block += step) {
     const std::uint16_t azimuth = block_azimuth(packet, block);
-    if (azimuth < kAzimuthLimit) __builtin_prefetch(&tables_.azimuth[azimuth]);
+    if (azimuth < kAzimuthLimit) __builtin_prefetch(&azimuth_table_.azimuth[azimuth]);
   }
 
   for (std::size_t block = 0; block < kBlocks; block += step) {
     const std::uint16_t azimuth = block_azimuth(packet, block);
-    // Azimuth advance over this block's 110.592 µs: towards the next firing's block, or for
+    // Azimuth advance over this block's duration (a VLP-16's 110.592 µs): towards the next firing's block, or for
     // the packet's last firing, the advance over the previous one.
     const std::uint32_t gap = block + step < kBlocks ? azimuth_gap(azimuth, block_azimuth(packet, block + step))
                                                      : azimuth_gap(block_azimuth(packet, block - step), azimuth);
@@ -299,12 +336,12 @@ __attribute__((always_inline)) inline PacketDecoder::Result PacketDecoder::decod
         if (second_raw == 0) continue;
       }
 
-      const std::size_t laser_index = channel % kLasers;
+      const std::size_t laser_index = channel_laser_[channel];
       const Laser& laser = lasers_[laser_index];
       const double cos_a = d.cos_a[channel];
       const double sin_a = d.sin_a[channel];
       const auto emit = [&](std::uint16_t raw, std::size_t from_block, ReturnType type) {
-        const double range = static_cast<double>(raw) * kDistanceUnit_m + laser.dist_correction_m;
+        const double range = static_cast<double>(raw) * distance_unit_m_ + laser.dist_correction_m;
         if (!(range >= min_range && range <= max_range)) {
           ++result.out_of_range;
           return;

@@ -51,7 +51,10 @@ PacketError validate_data_packet(std::span<const std::uint8_t> packet) noexcept 
     return PacketError::kUnknownReturnMode;
   }
   const std::uint8_t product = product_id(packet);
-  if (product != kProductVlp16 && product != kProductHdl32e) return PacketError::kUnsupportedProduct;
+  if (product != kProductVlp16 && product != kProductHdl32e && product != kProductPuckHiRes &&
+      product != kProductVlp32c) {
+    return PacketError::kUnsupportedProduct;
+  }
   return PacketError::kNone;
 }
 

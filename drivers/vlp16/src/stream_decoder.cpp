@@ -85,7 +85,16 @@ std::uint64_t StreamCounters::rejected_total() const noexcept {
 }
 
 StreamDecoder::StreamDecoder(const Calibration& calibration, StreamOptions options)
-    : decoder_(calibration, options.decode), options_(options) {
+    : options_(options), model_(options.detect_model ? std::nullopt : std::optional<Model>(options.model)) {
+  for (std::size_t m = 0; m < kModelCount; ++m) {
+    const auto model = static_cast<Model>(m);
+    if (model == options.model) {
+      decoders_[m] = std::make_unique<PacketDecoder>(calibration, options.decode, model);
+    } else if (options.detect_model) {
+      decoders_[m] = std::make_unique<PacketDecoder>(Calibration::for_model(model), options.decode, model);
+    }
+  }
+  current_ = decoders_[static_cast<std::size_t>(options.model)].get();
   options_.cut_azimuth_deg = wrapped_deg(options_.cut_azimuth_deg);
   held_.reserve(ModelCheck::kMaxUndecided);
   frame_.points.reserve(kFrameReserve);
@@ -103,11 +112,14 @@ void StreamDecoder::on_data_packet(std::span<const std::uint8_t> payload, std::i
     return;
   }
   switch (model_.check(payload)) {
-    case ModelCheck::Verdict::kVlp16:
+    case ModelCheck::Verdict::kDecided:
+      current_ = decoders_[static_cast<std::size_t>(model_.model())].get();
       for (const HeldPacket& held : held_)
         accept(held.bytes, held.receive_time_ns, sink, nullptr);
       held_.clear();
-      accept(payload, receive_time_ns, sink, decoded);
+      // Points decoded ahead by another model's decoder are decoded again here.
+      accept(payload, receive_time_ns, sink,
+             decoded != nullptr && decoded->model == model_.model() ? decoded : nullptr);
       return;
     case ModelCheck::Verdict::kUndecided:
       if (held_.size() < ModelCheck::kMaxUndecided) {
@@ -122,6 +134,13 @@ void StreamDecoder::on_data_packet(std::span<const std::uint8_t> payload, std::i
   }
   counters_.rejected[static_cast<std::size_t>(PacketError::kUnsupportedProduct)] += 1 + held_.size();
   held_.clear();
+}
+
+const PacketDecoder* StreamDecoder::decoder_for(std::span<const std::uint8_t> packet) const noexcept {
+  if (packet.size() != kDataPacketBytes) return nullptr;
+  std::optional<Model> model = unambiguous_model(vlp16::product_id(packet));
+  if (!model && vlp16::product_id(packet) == kProductHdl32e && !options_.detect_model) model = options_.model;
+  return model ? decoders_[static_cast<std::size_t>(*model)].get() : nullptr;
 }
 
 void StreamDecoder::on_position_packet(std::span<const std::uint8_t> payload) {
@@ -162,7 +181,8 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   const auto mode = static_cast<ReturnMode>(return_mode_byte(packet));
   const bool dual = mode == ReturnMode::kDual;
   const std::size_t step = dual ? 2 : 1;
-  const double period_us = static_cast<double>(kBlocks / step) * kBlockDuration_us;
+  const double block_us = spec(current_->model()).block_duration_us();
+  const double period_us = static_cast<double>(kBlocks / step) * block_us;
   const std::uint32_t toh = timestamp_us(packet);
   const std::uint16_t first_azimuth = block_azimuth(packet, 0);
 
@@ -234,7 +254,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   last_first_azimuth_ = first_azimuth;
   const std::size_t last_firing_block = kBlocks - step;
   const std::uint32_t span_cdeg = azimuth_gap(first_azimuth, block_azimuth(packet, last_firing_block));
-  rate_cdeg_per_us_ = static_cast<double>(span_cdeg) / (static_cast<double>(kBlocks / step - 1) * kBlockDuration_us);
+  rate_cdeg_per_us_ = static_cast<double>(span_cdeg) / (static_cast<double>(kBlocks / step - 1) * block_us);
 
   product_id_ = vlp16::product_id(packet);
   return_mode_ = mode;
@@ -320,7 +340,7 @@ PacketDecoder::Result StreamDecoder::decode_onto_frame(std::span<const std::uint
     r = decoded->result;
     ++counters_.decoded_ahead;
   } else {
-    r = decoder_.decode(packet, points);
+    r = current_->decode(packet, points);
   }
   ++counters_.decoded_packets;
   counters_.points += r.points;

@@ -51,6 +51,8 @@ struct DaemonConfig {
   TrajectoryCoordinates trajectory_coordinates = TrajectoryCoordinates::kGlobalXy;  // without a header line
 
   struct Lidar {
+    // auto (told from the packets' product id), vlp16, puck_lite, puck_hires, vlp32c, hdl32e.
+    std::string model = "auto";
     std::filesystem::path calibration;  // velodyne/nebula YAML; empty: the manual's values
     Eigen::Isometry3d robot_from_lidar = Eigen::Isometry3d::Identity();
     double min_range_m = 0.0;

@@ -82,11 +82,12 @@ class SweepProcessor {
   // end; position packets give the sensor's clock; GNSS and IMU bytes and localization messages
   // (pose.source lcm: 8 bytes of CLOCK_REALTIME − CLOCK_MONOTONIC at receipt, little-endian,
   // then the pose_input_t; one that does not decode is counted) feed the pose. `decoded`: a data
-  // packet's points decoded ahead by packet_decoder() on another thread, or null.
+  // packet's points decoded ahead by lidar_stream().decoder_for() on another thread, or null.
   void process(const inputs::InputItem& item, SweepSink& sink, const vlp16::DecodedPacket* decoded = nullptr);
   // The packet decoder the stream decodes with: const and stateless, for another thread to
   // decode packets ahead.
   [[nodiscard]] const vlp16::PacketDecoder& packet_decoder() const noexcept { return decoder_.decoder(); }
+  [[nodiscard]] const vlp16::StreamDecoder& lidar_stream() const noexcept { return decoder_; }
   // Steady-clock time the next datagram entered the daemon: a sweep keeps that of the last
   // datagram that gave it points (for the latency figures; no effect on the output).
   void set_input_arrival(std::int64_t steady_ns) noexcept { arrival_ns_ = steady_ns; }

@@ -1,6 +1,7 @@
 #pragma once
 
-// Decoding of VLP-16 data packets into points in the sensor frame.
+// Decoding of Velodyne data packets (the VLP-16's and the models of model.hpp) into points in
+// the sensor frame.
 //
 // Sensor frame (REP-103): x forward (azimuth 0), y left, z up, metres. The VLP-16 azimuth
 // grows clockwise seen from above. With ω the laser's vertical angle, R the corrected range,
@@ -19,6 +20,7 @@
 #include <string_view>
 #include <vector>
 
+#include "trajroi/vlp16/model.hpp"
 #include "trajroi/vlp16/packet.hpp"
 
 namespace trajroi::vlp16 {
@@ -32,20 +34,24 @@ struct LaserCalibration {
   double dist_correction_m = 0.0;   // added to the range
 };
 
-// Geometry of the 16 lasers, indexed by laser channel (firing order 0 … 15).
+// Geometry of the lasers (16 or 32), indexed by laser id (firing order 0 … laser_count − 1).
 struct Calibration {
-  std::array<LaserCalibration, kLasers> lasers{};
+  std::size_t laser_count = kLasers;
+  std::array<LaserCalibration, kMaxLasers> lasers{};
   // The VLP-16 manual's values: vertical angles −15, 1, −13, 3, … , −1, 15° in firing order,
   // and its vertical offset corrections (11.2 mm … −11.2 mm).
   [[nodiscard]] static Calibration vlp16_default();
+  // The model's manual values (model_calibration.cpp); the VLP-16's is vlp16_default().
+  [[nodiscard]] static Calibration for_model(Model model);
   // The rank of each laser by vertical angle (0 = lowest): the "ring" of point clouds.
-  [[nodiscard]] std::array<std::uint8_t, kLasers> rings() const;
+  [[nodiscard]] std::array<std::uint8_t, kMaxLasers> rings() const;
 };
 
 // Reads the velodyne/nebula calibration YAML (`lasers: [{laser_id, vert_correction,
 // rot_correction, vert_offset_correction, horiz_offset_correction, dist_correction, …}]`,
-// angles in radians, lengths in metres). Exactly the 16 laser ids 0 … 15 must appear.
-// Throws std::runtime_error naming `source`, the laser and the key on any problem.
+// angles in radians, lengths in metres): 16 or 32 lasers, each id 0 … n − 1 exactly once
+// (`num_lasers`, when present, must agree). Throws std::runtime_error naming `source`, the
+// line, the laser and the key on any problem.
 [[nodiscard]] Calibration parse_calibration_yaml(std::string_view text, std::string_view source);
 
 // Which return of a dual-return pair a point is. In dual mode each firing fills a block pair:
@@ -63,7 +69,7 @@ struct Point {
   std::uint32_t time_offset_ns;  // after the packet's first firing (its timestamp); in a
                                  // Frame, after the frame's start instead
   std::uint8_t intensity;        // calibrated reflectivity
-  std::uint8_t laser;            // laser channel 0 … 15 (firing order)
+  std::uint8_t laser;            // laser id 0 … 15 (31 for the 32-laser models), firing order
   std::uint8_t ring;             // rank by vertical angle, 0 = lowest
   ReturnType return_type;
 };
@@ -113,7 +119,9 @@ inline void reserve_packet_room(std::vector<Point>& out) {
 
 class PacketDecoder {
  public:
-  explicit PacketDecoder(const Calibration& calibration, DecodeOptions options = {});
+  // `calibration` must hold the model's number of lasers (std::invalid_argument otherwise).
+  explicit PacketDecoder(const Calibration& calibration, DecodeOptions options = {}, Model model = Model::kVlp16);
+  [[nodiscard]] Model model() const noexcept { return model_; }
 
   struct Result {
     std::size_t points = 0;          // appended to `out`
@@ -155,12 +163,20 @@ class PacketDecoder {
   // loops without branches (the compiler vectorizes them).
   void directions(std::uint16_t azimuth, std::uint32_t gap, Directions& d) const noexcept;
   Result decode_body(std::span<const std::uint8_t> packet, std::vector<Point>& out) const;
-  struct AngleTables;
-  [[nodiscard]] static const AngleTables& angle_tables();  // built at the first call, then shared
+  struct AzimuthTable;
+  struct StepTables;
+  // Built at the first call, then shared: the azimuths' cos/sin by every decoder, the in-block
+  // steps by the decoders of one model.
+  [[nodiscard]] static const AzimuthTable& azimuth_table();
+  [[nodiscard]] static const StepTables& step_tables(Model model);
+  Model model_;
   DecodeOptions options_;
-  const AngleTables& tables_;
-  std::array<Laser, kLasers> lasers_{};
-  bool rotation_corrected_ = false;  // some rot_correction ≠ 0
+  double distance_unit_m_;
+  const AzimuthTable& azimuth_table_;
+  const StepTables& step_tables_;
+  std::array<Laser, kMaxLasers> lasers_{};
+  std::array<std::uint8_t, kFiringsPerBlock * kLasers> channel_laser_{};  // per channel of a block
+  bool rotation_corrected_ = false;                                       // some rot_correction ≠ 0
   // Per channel 0 … 31 of a block: its firing time after the block's first, as a fraction of
   // the block's duration (for azimuth interpolation).
   std::array<double, kFiringsPerBlock * kLasers> azimuth_fraction_{};

@@ -36,6 +36,8 @@ inline constexpr std::int64_t kHour_us = 3'600'000'000;  // timestamps count µs
 enum class ReturnMode : std::uint8_t { kStrongest = 0x37, kLast = 0x38, kDual = 0x39 };
 inline constexpr std::uint8_t kProductVlp16 = 0x22;
 inline constexpr std::uint8_t kProductHdl32e = 0x21;
+inline constexpr std::uint8_t kProductPuckHiRes = 0x24;
+inline constexpr std::uint8_t kProductVlp32c = 0x28;
 
 // Why a data packet was not decoded. Counted by the caller, never thrown.
 enum class PacketError : std::uint8_t {
@@ -98,9 +100,10 @@ inline constexpr auto& read_u32 = framing::le_u32;
   return delta - kHour_us / 2;
 }
 
-// Checks size, every block flag and azimuth, the return mode and the product id. Product
-// 0x22 (VLP-16) and 0x21 (HDL-32E code, sent by early VLP-16 firmware; the caller decides
-// from the packet timing) pass; any other id is kUnsupportedProduct.
+// Checks size, every block flag and azimuth, the return mode and the product id. The ids of
+// the models trajroi decodes pass (0x22 VLP-16 and Puck LITE, 0x24 Puck Hi-Res, 0x28 VLP-32C,
+// 0x21 HDL-32E or early VLP-16 firmware: ModelCheck decides by timing); any other id is
+// kUnsupportedProduct.
 [[nodiscard]] PacketError validate_data_packet(std::span<const std::uint8_t> packet) noexcept;
 
 // A readable name for a product id byte ("VLP-32C" for 0x28), for rejection messages.

@@ -25,6 +25,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -45,6 +46,12 @@ inline constexpr std::int64_t kMaxFrameDuration_ns = 2'000'000'000;
 
 struct StreamOptions {
   DecodeOptions decode;
+  // The model the calibration is for. Alone (detect_model false: lidar.model names it) the
+  // packets of any other model are rejected and named; with detect_model (lidar.model: auto)
+  // the model of the packets is taken, any of model.hpp's, the others with their manuals'
+  // geometry (Calibration::for_model).
+  Model model = Model::kVlp16;
+  bool detect_model = false;
   // A frame begins with the first point whose (interpolated) firing azimuth is at or past
   // this azimuth; a firing that straddles it is split between the two frames.
   double cut_azimuth_deg = 0.0;
@@ -122,6 +129,7 @@ inline constexpr std::uint32_t kFrameEndMargin_cdeg = 100;
 // ones). `tag` ties it to its packet (the caller's sequence number).
 struct DecodedPacket {
   std::uint64_t tag = 0;
+  Model model = Model::kVlp16;  // of the decoder that decoded it
   PacketDecoder::Result result;
   // Room for a whole packet, its memory touched: decoding into it never allocates nor faults.
   std::vector<Point> points;
@@ -141,9 +149,16 @@ class StreamDecoder {
   // null.
   void on_data_packet(std::span<const std::uint8_t> payload, std::int64_t receive_time_ns, FrameSink& sink,
                       const DecodedPacket* decoded = nullptr);
-  // The packet decoder this stream decodes with; decode() is const and keeps no state, so
+  // The packet decoder of StreamOptions::model; decode() is const and keeps no state, so
   // another thread may decode packets ahead with it.
-  [[nodiscard]] const PacketDecoder& decoder() const noexcept { return decoder_; }
+  [[nodiscard]] const PacketDecoder& decoder() const noexcept {
+    return *decoders_[static_cast<std::size_t>(options_.model)];
+  }
+  // The decoder a packet would be decoded with, from its product id alone (safe on any
+  // thread: the decoders never change), or null when its bytes cannot tell (an 0x21 packet
+  // while the model is detected) or no decoder of this stream takes it. A packet decoded
+  // ahead with it is still checked by the stream (DecodedPacket::model).
+  [[nodiscard]] const PacketDecoder* decoder_for(std::span<const std::uint8_t> packet) const noexcept;
   // One port-8308 payload.
   void on_position_packet(std::span<const std::uint8_t> payload);
   // Delivers the frame in progress (partial), e.g. at the end of a capture.
@@ -174,7 +189,9 @@ class StreamDecoder {
   void finish_frame(FrameSink& sink, bool partial);
   void report_points(FrameSink& sink);
 
-  PacketDecoder decoder_;
+  std::array<std::unique_ptr<PacketDecoder>, kModelCount> decoders_;  // options_.model's, and with
+                                                                      // detect_model every model's
+  const PacketDecoder* current_ = nullptr;                            // the stream's model's
   StreamOptions options_;
   ModelCheck model_;
   TopOfHourClock utc_clock_;
