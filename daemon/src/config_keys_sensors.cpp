@@ -116,8 +116,8 @@ void add_sensor_keys(std::vector<ConfigKey>& k) {
        },
        [](const DaemonConfig& c) { return c.lidar.model; }});
   k.push_back({"lidar.calibration", "path",
-               "velodyne/nebula calibration YAML (16 or 32 lasers) for lidar.model (auto: 16 lasers, a VLP-16); "
-               "empty: the model's manual values",
+               "velodyne/nebula YAML or VeloView XML calibration (16 or 32 lasers) for lidar.model (auto: 16 lasers, "
+               "a VLP-16); empty: the model's manual values",
                false,
                [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir& dir) {
                  c.lidar.calibration = resolve(dir, m.text(key, c.lidar.calibration.string()));

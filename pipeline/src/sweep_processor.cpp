@@ -34,7 +34,7 @@ vlp16::Calibration load_calibration(const DaemonConfig& c) {
   const std::filesystem::path& file = c.lidar.calibration;
   const std::optional<vlp16::Model> model = vlp16::model_named(c.lidar.model);
   if (file.empty()) return vlp16::Calibration::for_model(model.value_or(vlp16::Model::kVlp16));
-  vlp16::Calibration calibration = vlp16::parse_calibration_yaml(config::read_text_file(file), file.string());
+  vlp16::Calibration calibration = vlp16::parse_calibration_file(config::read_text_file(file), file.string());
   const vlp16::ModelSpec& s = vlp16::spec(model.value_or(vlp16::Model::kVlp16));
   if (!model && calibration.laser_count != s.lasers) {
     throw config::ConfigError("lidar.calibration " + file.string() + ": " + std::to_string(calibration.laser_count) +

@@ -70,8 +70,10 @@ double azimuth_deg(double x, double y) {
 }
 
 double wrapped(double d) {
-  while (d > 180.0) d -= 360.0;
-  while (d < -180.0) d += 360.0;
+  while (d > 180.0)
+    d -= 360.0;
+  while (d < -180.0)
+    d += 360.0;
   return d;
 }
 
@@ -88,7 +90,7 @@ TEST(Vlp32cCapture, NebulasReferenceCloudIsReproducedPointForPoint) {
   TRAJROI_REQUIRE_DATA(capture, "velodyne/other_models/nebula_vlp32c_strongest_1713492677.DERIVED.pcap");
   TRAJROI_REQUIRE_DATA(pcd, "velodyne/other_models/nebula_vlp32c_reference_1713492677464078412.pcd");
   StreamOptions options = auto_model(0.4 + 1e-6, 50.0 - 1e-6);
-  options.model = Model::kVlp32c;  // the calibration's
+  options.model = Model::kVlp32c;   // the calibration's
   options.cut_azimuth_deg = 180.0;  // nebula's scan_phase: its sweep runs 270° → 90° through 0°
   const Replayed r = replay(capture, Calibration::for_model(Model::kVlp32c), options);
   ASSERT_TRUE(r.decided);
@@ -210,10 +212,10 @@ TEST(Vlp32cCapture, NebulasReferenceCloudIsReproducedPointForPoint) {
 
 // The HDL-32E manual's tables: vertical angle per laser (firing order), 1.152 µs between
 // lasers, 46.08 µs per firing sequence (one per block), 2 mm distance units.
-constexpr double kHdl32eVerticalDeg[32] = {-30.67, -9.33,  -29.33, -8.00,  -28.00, -6.67,  -26.67, -5.33,
-                                           -25.33, -4.00,  -24.00, -2.67,  -22.67, -1.33,  -21.33, 0.00,
-                                           -20.00, 1.33,   -18.67, 2.67,   -17.33, 4.00,   -16.00, 5.33,
-                                           -14.67, 6.67,   -13.33, 8.00,   -12.00, 9.33,   -10.67, 10.67};
+constexpr double kHdl32eVerticalDeg[32] = {-30.67, -9.33, -29.33, -8.00, -28.00, -6.67, -26.67, -5.33,
+                                           -25.33, -4.00, -24.00, -2.67, -22.67, -1.33, -21.33, 0.00,
+                                           -20.00, 1.33,  -18.67, 2.67,  -17.33, 4.00,  -16.00, 5.33,
+                                           -14.67, 6.67,  -13.33, 8.00,  -12.00, 9.33,  -10.67, 10.67};
 
 struct Expected {
   double x, y, z;
@@ -263,8 +265,8 @@ TEST_P(Hdl32eCapture, EveryPacketIsTheManualsDecode) {
     for (std::size_t i = 0; i < ours.size(); ++i) {
       ASSERT_EQ(ours[i].laser, manual[i].laser);
       ASSERT_EQ(ours[i].intensity, manual[i].intensity);
-      const double e = std::hypot(double{ours[i].x} - manual[i].x, double{ours[i].y} - manual[i].y,
-                                  double{ours[i].z} - manual[i].z);
+      const double e =
+          std::hypot(double{ours[i].x} - manual[i].x, double{ours[i].y} - manual[i].y, double{ours[i].z} - manual[i].z);
       worst = std::max(worst, e);
     }
     ++packets;
@@ -275,9 +277,10 @@ TEST_P(Hdl32eCapture, EveryPacketIsTheManualsDecode) {
   EXPECT_LE(worst, 1e-4) << "worst " << worst << " m over " << points << " points";
 }
 
-INSTANTIATE_TEST_SUITE_P(Captures, Hdl32eCapture,
-                         testing::Values("velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap",
-                                         "velodyne/other_models/rust-lidar-utils_velodyne_vlp32_ACTUALLY_HDL-32E.pcap"));
+INSTANTIATE_TEST_SUITE_P(
+    Captures, Hdl32eCapture,
+    testing::Values("velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap",
+                    "velodyne/other_models/rust-lidar-utils_velodyne_vlp32_ACTUALLY_HDL-32E.pcap"));
 
 // MRPT's unit test reads its HDL-32E sample as three scans; told from the packets (0x21 at
 // 553 µs), not configured.
@@ -382,6 +385,56 @@ TEST(ModelGeometry, ThirtyTwoLaserCalibrationsReadAndMustFitTheModel) {
     ADD_FAILURE() << "accepted";
   } catch (const std::runtime_error& e) {
     EXPECT_EQ(std::string(e.what()), "vlp32.yaml:34: 'num_lasers' says 16 but 'lasers' has 32 entries");
+  }
+}
+
+// VeloView's XML (db.xml): degrees and centimetres, as the ROS driver's gen_calibration.py
+// reads them; a laser missing an element is named with its line.
+TEST(ModelGeometry, VeloViewXmlCalibrationsRead) {
+  std::string xml =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\" standalone=\"yes\" ?>\n<!DOCTYPE boost_serialization>\n"
+      "<boost_serialization signature=\"serialization::archive\" version=\"4\">\n<DB class_id=\"0\">\n"
+      "<distLSB_>0.4</distLSB_>\n<points_ class_id=\"5\" tracking_level=\"0\" version=\"0\">\n"
+      "<count>32</count>\n<item_version>1</item_version>\n";
+  constexpr double kVertical[32] = {-25.0,  -1.0,  -1.667, -15.639, -11.31, 0.0,   -0.667, -8.843,
+                                    -7.254, 0.333, -0.333, -6.148,  -5.333, 1.333, 0.667,  -4.0,
+                                    -4.667, 1.667, 1.0,    -3.667,  -3.333, 3.333, 2.333,  -2.667,
+                                    -3.0,   7.0,   4.667,  -2.333,  -2.0,   15.0,  10.333, -1.333};
+  constexpr double kRotation[32] = {-1.4, 4.2,  -1.4, 1.4,  -1.4, 1.4,  -4.2, 1.4,  -1.4, 4.2,  -1.4,
+                                    1.4,  -4.2, 1.4,  -4.2, 1.4,  -1.4, 4.2,  -1.4, 4.2,  -4.2, 1.4,
+                                    -1.4, 1.4,  -1.4, 1.4,  -1.4, 4.2,  -4.2, 1.4,  -1.4, 1.4};
+  for (int i = 0; i < 32; ++i) {
+    char item[400];
+    std::snprintf(
+        item, sizeof item,
+        "<item class_id=\"6\" tracking_level=\"0\" version=\"1\">\n<px class_id=\"7\">\n<id_>%d</id_>\n"
+        "<rotCorrection_>%g</rotCorrection_>\n<vertCorrection_>%g</vertCorrection_>\n"
+        "<distCorrection_>%d</distCorrection_>\n<distCorrectionX_>0</distCorrectionX_>\n"
+        "<vertOffsetCorrection_>0</vertOffsetCorrection_>\n<horizOffsetCorrection_>0</horizOffsetCorrection_>\n"
+        "</px>\n</item>\n",
+        i, kRotation[i], kVertical[i], i == 3 ? 12 : 0);
+    xml += item;
+  }
+  xml += "</points_>\n</DB>\n</boost_serialization>\n";
+  ASSERT_TRUE(looks_like_calibration_xml(xml));
+  const Calibration c = parse_calibration_file(xml, "VLP-32c.xml");
+  const Calibration manual = Calibration::for_model(Model::kVlp32c);
+  ASSERT_EQ(c.laser_count, 32u);
+  for (std::size_t i = 0; i < 32; ++i) {
+    EXPECT_NEAR(c.lasers[i].vert_angle_rad, manual.lasers[i].vert_angle_rad, 1e-12) << i;
+    EXPECT_NEAR(c.lasers[i].rot_correction_rad, manual.lasers[i].rot_correction_rad, 1e-12) << i;
+  }
+  EXPECT_DOUBLE_EQ(c.lasers[3].dist_correction_m, 0.12);  // 12 cm
+  // Laser 5's <vertCorrection_> gone: named with its line.
+  const std::size_t cut = xml.find("<vertCorrection_>0</vertCorrection_>");
+  ASSERT_NE(cut, std::string::npos);
+  std::string broken = xml;
+  broken.erase(cut, std::string("<vertCorrection_>0</vertCorrection_>").size());
+  try {
+    (void)parse_calibration_file(broken, "VLP-32c.xml");
+    ADD_FAILURE() << "accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "VLP-32c.xml:65: laser entry 5 has no <vertCorrection_>");  // its <px> line
   }
 }
 

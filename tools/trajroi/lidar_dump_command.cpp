@@ -124,7 +124,7 @@ void run_lidar_dump(const LidarDumpOptions& o) {
   const std::optional<Model> named = model_named(o.model);
   Calibration calibration = Calibration::for_model(named.value_or(Model::kVlp16));
   if (!o.calibration.empty()) {
-    calibration = parse_calibration_yaml(read_text_file(o.calibration), o.calibration);
+    calibration = parse_calibration_file(read_text_file(o.calibration), o.calibration);
     const ModelSpec& s = spec(named.value_or(Model::kVlp16));
     if (calibration.laser_count != s.lasers) {
       throw std::runtime_error(o.calibration + ": " + std::to_string(calibration.laser_count) + " lasers, but a " +
@@ -246,7 +246,7 @@ void add_lidar_dump_command(CLI::App& app) {
   cmd->add_option("--model", o->model, "auto (from the packets' product id) or the sensor's model")
       ->check(CLI::IsMember({"auto", "vlp16", "puck_lite", "puck_hires", "vlp32c", "hdl32e"}));
   cmd->add_option("--calibration", o->calibration,
-                  "velodyne/nebula calibration YAML for --model (default: the model's manual values)")
+                  "calibration for --model: velodyne/nebula YAML or VeloView XML (default: the model's manual values)")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--json", o->json, "print one JSON object");
   cmd->add_option("--points", o->points_csv,

@@ -53,6 +53,14 @@ struct Calibration {
 // (`num_lasers`, when present, must agree). Throws std::runtime_error naming `source`, the
 // line, the laser and the key on any problem.
 [[nodiscard]] Calibration parse_calibration_yaml(std::string_view text, std::string_view source);
+// Reads VeloView's calibration XML (Velodyne's db.xml: <points_><item><px><id_>,
+// <rotCorrection_>, <vertCorrection_> in degrees, <distCorrection_>, <vertOffsetCorrection_>,
+// <horizOffsetCorrection_> in centimetres): 16 or 32 lasers. Throws std::runtime_error naming
+// `source`, the line and the element.
+[[nodiscard]] Calibration parse_calibration_xml(std::string_view text, std::string_view source);
+[[nodiscard]] bool looks_like_calibration_xml(std::string_view text) noexcept;
+// Either form, told by its content.
+[[nodiscard]] Calibration parse_calibration_file(std::string_view text, std::string_view source);
 
 // Which return of a dual-return pair a point is. In dual mode each firing fills a block pair:
 // the even block holds the last return, the odd block the strongest (or, when the strongest

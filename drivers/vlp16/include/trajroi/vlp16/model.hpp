@@ -28,11 +28,11 @@ struct ModelSpec {
   std::string_view name;         // "VLP-32C"
   std::string_view config_name;  // "vlp32c", as lidar.model names it
   std::uint8_t product_id;
-  std::size_t lasers;             // 16 or 32
-  std::size_t lasers_per_group;   // fired together: 1, or 2 (VLP-32C)
-  double laser_period_us;         // between two firing groups
-  double firing_cycle_us;         // one firing sequence of every laser, recharge included
-  std::int64_t laser_period_ns;   // the same in whole nanoseconds
+  std::size_t lasers;            // 16 or 32
+  std::size_t lasers_per_group;  // fired together: 1, or 2 (VLP-32C)
+  double laser_period_us;        // between two firing groups
+  double firing_cycle_us;        // one firing sequence of every laser, recharge included
+  std::int64_t laser_period_ns;  // the same in whole nanoseconds
   std::int64_t firing_cycle_ns;
   double distance_unit_m;
 
@@ -63,7 +63,9 @@ struct ModelSpec {
 };
 
 [[nodiscard]] const ModelSpec& spec(Model model) noexcept;
-[[nodiscard]] inline std::string_view to_string(Model model) noexcept { return spec(model).name; }
+[[nodiscard]] inline std::string_view to_string(Model model) noexcept {
+  return spec(model).name;
+}
 // The model a product id byte names without doubt: 0x22, 0x24, 0x28 (0x21 is the HDL-32E's,
 // but early VLP-16 firmware sent it too: ModelCheck decides it by timing); nullopt otherwise.
 [[nodiscard]] std::optional<Model> unambiguous_model(std::uint8_t product_id) noexcept;
