@@ -1,4 +1,5 @@
-// The VLP-16 calibration YAML (velodyne_pointcloud / nebula format).
+// Velodyne calibration files: the velodyne_pointcloud / nebula YAML and VeloView's XML, each
+// told by its content.
 #include <cstdint>
 #include <stdexcept>
 
@@ -7,7 +8,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
-    (void)trajroi::vlp16::parse_calibration_yaml(trajroi::fuzz::as_text(data, size), "fuzz.yaml");
+    (void)trajroi::vlp16::parse_calibration_file(trajroi::fuzz::as_text(data, size), "fuzz.calibration");
   } catch (const std::exception&) {
   }
   return 0;
