@@ -108,13 +108,15 @@ void add_sensor_keys(std::vector<ConfigKey>& k) {
                },
                [](const DaemonConfig& c) { return std::string(coordinates_text(c.trajectory_coordinates)); }});
   // ---- lidar
-  k.push_back(
-      {"lidar.model", "auto | vlp16 | puck_lite | puck_hires | vlp32c | hdl32e",
-       "auto: told from the packets' product id; a model: other models' packets are dropped and named", false,
-       [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
-         c.lidar.model = m.choice(key, {"auto", "vlp16", "puck_lite", "puck_hires", "vlp32c", "hdl32e"}, c.lidar.model);
-       },
-       [](const DaemonConfig& c) { return c.lidar.model; }});
+  k.push_back({"lidar.model", "auto | vlp16 | puck_lite | puck_hires | vlp32c | hdl32e",
+               "auto: told from the packets' product id; a model: other models' packets are dropped and named", false,
+               [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
+                 // "VLP-16": the one value before the other models (configurations written then).
+                 c.lidar.model = m.choice(
+                     key, {"auto", "vlp16", "puck_lite", "puck_hires", "vlp32c", "hdl32e", "VLP-16"}, c.lidar.model);
+                 if (c.lidar.model == "VLP-16") c.lidar.model = "vlp16";
+               },
+               [](const DaemonConfig& c) { return c.lidar.model; }});
   k.push_back({"lidar.calibration", "path",
                "velodyne/nebula YAML or VeloView XML calibration (16 or 32 lasers) for lidar.model (auto: 16 lasers, "
                "a VLP-16); empty: the model's manual values",

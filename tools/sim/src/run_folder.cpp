@@ -156,7 +156,7 @@ std::string daemon_config(const Scenario& s) {
                 "trajectory:\n"
                 "  file: %s\n"
                 "lidar:\n"
-                "  model: VLP-16\n"
+                "  model: vlp16\n"
                 "  mounting: {xyz: [%.4f, %.4f, %.4f], roll_deg: %.4f, pitch_deg: %.4f, yaw_deg: %.4f}\n"
                 "  min_range_m: %.3f\n"
                 "  max_range_m: %.3f\n"
