@@ -136,7 +136,7 @@ TEST(Vlp32cCapture, NebulasReferenceCloudIsReproducedPointForPoint) {
   for (const Ours& o : all) {
     if (o.point.laser != 0) continue;
     if (previous) {
-      const double d = wrapped(double{o.point.azimuth_deg} - *previous);
+      const double d = wrapped(static_cast<double>(o.point.azimuth_deg) - *previous);
       if (d > 0.0 && d < 1.0) steps.push_back(d);
     }
     previous = o.point.azimuth_deg;
@@ -156,7 +156,7 @@ TEST(Vlp32cCapture, NebulasReferenceCloudIsReproducedPointForPoint) {
   // Our point for reference point i: same raw distance, unused, in `frame` (any when none),
   // within 1 mm once turned to nebula's azimuth, the least turn.
   const auto find = [&](std::size_t i, std::optional<std::size_t> frame, double& turn, double& error) -> const Ours* {
-    const double px = x[i], py = y[i], pz = z[i];
+    const double px = static_cast<double>(x[i]), py = static_cast<double>(y[i]), pz = static_cast<double>(z[i]);
     const double range = std::sqrt(px * px + py * py + pz * pz);
     const double nebula_az = azimuth_deg(px, py);
     const Ours* best = nullptr;
@@ -164,7 +164,7 @@ TEST(Vlp32cCapture, NebulasReferenceCloudIsReproducedPointForPoint) {
     for (auto it = begin; it != end; ++it) {
       const Point& p = it->second->point;
       if ((frame && it->second->frame != *frame) || used.count(&p) != 0) continue;
-      const double ox = p.x, oy = p.y, oz = p.z;
+      const double ox = static_cast<double>(p.x), oy = static_cast<double>(p.y), oz = static_cast<double>(p.z);
       const double t = wrapped(nebula_az - azimuth_deg(ox, oy));
       if (std::abs(t - convention_turn(p.laser, it->second->last_block)) > kTurnToleranceDeg) continue;
       const double c = std::cos(t * kDeg), s = std::sin(t * kDeg);
@@ -266,7 +266,8 @@ TEST_P(Hdl32eCapture, EveryPacketIsTheManualsDecode) {
       ASSERT_EQ(ours[i].laser, manual[i].laser);
       ASSERT_EQ(ours[i].intensity, manual[i].intensity);
       const double e =
-          std::hypot(double{ours[i].x} - manual[i].x, double{ours[i].y} - manual[i].y, double{ours[i].z} - manual[i].z);
+          std::hypot(static_cast<double>(ours[i].x) - manual[i].x, static_cast<double>(ours[i].y) - manual[i].y,
+                     static_cast<double>(ours[i].z) - manual[i].z);
       worst = std::max(worst, e);
     }
     ++packets;
