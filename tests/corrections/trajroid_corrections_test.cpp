@@ -235,6 +235,45 @@ TEST(TrajroidCorrections, AStreamThatIsNotRtcm3IsNamedAndNothingIsWritten) {
   fs::remove_all(dir);
 }
 
+// A radio modem's serial port (serial://): a pseudo-terminal the test writes the base's frames
+// into as a 57600-baud radio link delivers them, in pieces with noise between.
+TEST(TrajroidCorrections, ARadioSerialPortReachesTheReceiverExactly) {
+  REQUIRE_RIG(rig);
+  const int radio = posix_openpt(O_RDWR | O_NOCTTY);
+  ASSERT_GE(radio, 0);
+  ASSERT_EQ(grantpt(radio), 0);
+  ASSERT_EQ(unlockpt(radio), 0);
+  termios t{};
+  ASSERT_EQ(tcgetattr(radio, &t), 0);
+  cfmakeraw(&t);
+  ASSERT_EQ(tcsetattr(radio, TCSANOW, &t), 0);
+  const std::string url = std::string("serial://") + ptsname(radio) + "?baud=57600";
+  Receiver rx(rig.rover, std::chrono::milliseconds(1000));
+  const std::string prefix = "RTK_RADIO";
+  const fs::path dir = write_config(prefix, rx.path(), url);
+  Listener listener(prefix);
+  const fs::path log = dir / "trajroid.log";
+  Child trajroid({"--config", (dir / "trajroid.yaml").string(), "--lcm-url", daemon_test::kTestLcmUrl}, log);
+  // trajroid is up (its first status) and has opened the radio's port.
+  ASSERT_TRUE(listener.wait_for([&] { return !listener.statuses.empty(); }, std::chrono::seconds(10)))
+      << daemon_test::slurp(log);
+  std::size_t corrupted = 0;
+  const Bytes bytes = with_noise(rig.frames, 0, 182, corrupted);
+  for (std::size_t at = 0; at < bytes.size(); at += 256) {
+    const std::size_t n = std::min<std::size_t>(256, bytes.size() - at);
+    ASSERT_EQ(write(radio, bytes.data() + at, n), static_cast<ssize_t>(n));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_TRUE(wait_frames(rx, 182)) << rx.split().rtcm.size() << " frames\n" << daemon_test::slurp(log);
+  EXPECT_TRUE(log_says(log, "corrections: receiving corrections on " + url)) << daemon_test::slurp(log);
+  expect_status(listener, rig.frames, corrupted, "streaming from " + url);
+  trajroid.signal(SIGTERM);
+  EXPECT_EQ(trajroid.wait(std::chrono::seconds(10)), 0) << daemon_test::slurp(log);
+  expect_exactly(rx, rig.frames);
+  close(radio);
+  fs::remove_all(dir);
+}
+
 // rtcm_t on LCM, published with liblcm by a "base station" elsewhere: the frames cut at
 // arbitrary points across messages, noise and corrupted copies between them.
 TEST(TrajroidCorrections, LcmRtcmMessagesReachTheReceiverExactly) {
