@@ -7,6 +7,7 @@
 #include <cmath>
 #include <functional>
 
+#include "model_replay.hpp"
 #include "packet_builder.hpp"
 
 namespace trajroi::vlp16 {
@@ -41,10 +42,7 @@ struct Sensor {
   [[nodiscard]] std::int64_t received() const { return receive_ns; }
 };
 
-struct Collector final : FrameSink {
-  std::vector<Frame> frames;
-  void on_frame(const Frame& frame) override { frames.push_back(frame); }
-};
+using model_test::Collector;
 
 // Feeds `count` packets of `sensor`, letting `edit` drop (return false) or change each.
 struct Outcome {
