@@ -256,13 +256,11 @@ TEST_P(ModelFromPackets, IsToldAndEveryPacketDecoded) {
 
 INSTANTIATE_TEST_SUITE_P(
     Captures, ModelFromPackets,
-    testing::Values(ToldCapture{"velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap", Model::kHdl32e, 500},
-                    ToldCapture{"velodyne/other_models/rust-lidar-utils_velodyne_vlp32_ACTUALLY_HDL-32E.pcap",
-                                Model::kHdl32e, 91},
-                    ToldCapture{"velodyne/vlp16/rust-lidar-utils_velodyne_vlp16_2014_productid0x21.pcap",
-                                Model::kVlp16, 84},
-                    ToldCapture{"velodyne/other_models/nebula_vlp32c_strongest_1713492677.DERIVED.pcap",
-                                Model::kVlp32c, 379}));
+    testing::Values(
+        ToldCapture{"velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap", Model::kHdl32e, 500},
+        ToldCapture{"velodyne/other_models/rust-lidar-utils_velodyne_vlp32_ACTUALLY_HDL-32E.pcap", Model::kHdl32e, 91},
+        ToldCapture{"velodyne/vlp16/rust-lidar-utils_velodyne_vlp16_2014_productid0x21.pcap", Model::kVlp16, 84},
+        ToldCapture{"velodyne/other_models/nebula_vlp32c_strongest_1713492677.DERIVED.pcap", Model::kVlp32c, 379}));
 
 }  // namespace
 }  // namespace trajroi::vlp16
