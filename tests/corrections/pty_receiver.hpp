@@ -13,6 +13,7 @@
 #include <atomic>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -128,6 +129,33 @@ class Receiver {
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };
+
+// A run folder for trajroid reading the pseudo-terminal receiver at `device`, the pose from the
+// GNSS alone (a 10 m trajectory at the F9R log's site), LCM channels `prefix`_*: `gnss` and
+// `pose` are lines added under those keys, `extra` whole sections.
+inline std::filesystem::path write_rover_config(const std::string& prefix, const std::string& device,
+                                                const std::string& gnss, const std::string& pose,
+                                                const std::string& extra = "") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(::testing::TempDir()) / (prefix + "_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "trajectory.csv") << "0,0\n10,0\n";
+  std::ofstream(dir / "trajroid.yaml")
+      << "global_frame:\n  origin: {lat_deg: 45.0657, lon_deg: 7.6590, height_m: 300.0}\n"
+      << "trajectory:\n  file: trajectory.csv\n"
+      << "lidar:\n  data_port: 0\n  position_port: 0\n"
+      << "gnss:\n  device: " << device << "\n"
+      << gnss << "pose:\n  source: gnss\n  gnss_heading: {initial_heading_deg: 90}\n"
+      << pose << extra << "lcm:\n  channels: {points: " << prefix << "_POINTS, pose: " << prefix
+      << "_POSE, roi: " << prefix << "_ROI, status: " << prefix << "_STATUS, trajectory: " << prefix
+      << "_TRAJECTORY, active_trajectory: " << prefix << "_ACTIVE}\n";
+  return dir;
+}
+
+// trajroid's arguments for the run folder `dir` on the tests' LCM URL (its log: dir/trajroid.log).
+inline std::vector<std::string> trajroid_args(const std::filesystem::path& dir) {
+  return {"--config", (dir / "trajroid.yaml").string(), "--lcm-url", daemon_test::kTestLcmUrl};
+}
 
 // Waits until the log holds `text` at least `times` times.
 inline bool log_says(const std::filesystem::path& log, const std::string& text, int times = 1, double seconds = 15.0) {

@@ -29,6 +29,7 @@ namespace fs = std::filesystem;
 
 constexpr int kUnit = 13;
 constexpr key_t kKey = 0x4E545030 + kUnit;
+const std::string kChronyTime = "time:\n  chrony_shm: 13\n";
 
 // chronyd's path: in /usr/sbin, which a test's PATH may leave out.
 std::string chronyd_path() {
@@ -66,20 +67,10 @@ TEST(TrajroidChrony, ChronydReadsTheGnssTimeTrajroidWrites) {
 
   Receiver rx(trajroi::test::read_file(rover_path), std::chrono::milliseconds(1000));
   const std::string prefix = "CHRONY";
-  std::ofstream(dir / "trajectory.csv") << "0,0\n10,0\n";
-  std::ofstream(dir / "trajroid.yaml")
-      << "global_frame:\n  origin: {lat_deg: 45.0657, lon_deg: 7.6590, height_m: 300.0}\n"
-      << "trajectory:\n  file: trajectory.csv\n"
-      << "lidar:\n  data_port: 0\n  position_port: 0\n"
-      << "gnss:\n  device: " << rx.path() << "\n  configure: false\n"
-      << "pose:\n  source: gnss\n  gnss_heading: {initial_heading_deg: 90}\n"
-      << "time:\n  chrony_shm: " << kUnit << "\n"
-      << "lcm:\n  channels: {points: " << prefix << "_POINTS, pose: " << prefix << "_POSE, roi: " << prefix
-      << "_ROI, status: " << prefix << "_STATUS, trajectory: " << prefix << "_TRAJECTORY, active_trajectory: " << prefix
-      << "_ACTIVE}\n";
+  const fs::path run = write_rover_config(prefix, rx.path(), "  configure: false\n", "", kChronyTime);
   Listener listener(prefix);
-  const fs::path log = dir / "trajroid.log";
-  Child trajroid({"--config", (dir / "trajroid.yaml").string(), "--lcm-url", daemon_test::kTestLcmUrl}, log);
+  const fs::path log = run / "trajroid.log";
+  Child trajroid(trajroid_args(run), log);
   ASSERT_TRUE(log_says(log, "writing each NAV-PVT's UTC into chronyd's SHM 13")) << daemon_test::slurp(log);
 
   // chronyd -Q exits once it has a measurement: "System clock wrong by X seconds (ignored)".
@@ -108,6 +99,7 @@ TEST(TrajroidChrony, ChronydReadsTheGnssTimeTrajroidWrites) {
   trajroid.signal(SIGTERM);
   EXPECT_EQ(trajroid.wait(std::chrono::seconds(10)), 0) << daemon_test::slurp(log);
   fs::remove_all(dir);
+  fs::remove_all(run);
 }
 
 // Without chronyd's segment: named with what to do, retried, and trajroid runs on.
@@ -116,20 +108,9 @@ TEST(TrajroidChrony, AMissingSegmentIsNamedAndTheDaemonRunsOn) {
   if (unshare(CLONE_NEWIPC) != 0) std::cerr << "no private IPC namespace (not root): SHM unit 13 of this host\n";
   if (segment_exists()) GTEST_SKIP() << "SHM unit 13 exists on this host";
   Receiver rx(trajroi::test::read_file(rover_path), std::chrono::milliseconds(1000));
-  const fs::path dir = fs::path(::testing::TempDir()) / ("chrony_missing_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  std::ofstream(dir / "trajectory.csv") << "0,0\n10,0\n";
-  std::ofstream(dir / "trajroid.yaml")
-      << "global_frame:\n  origin: {lat_deg: 45.0657, lon_deg: 7.6590, height_m: 300.0}\n"
-      << "trajectory:\n  file: trajectory.csv\n"
-      << "lidar:\n  data_port: 0\n  position_port: 0\n"
-      << "gnss:\n  device: " << rx.path() << "\n  configure: false\n"
-      << "pose:\n  source: gnss\n  gnss_heading: {initial_heading_deg: 90}\n"
-      << "time:\n  chrony_shm: " << kUnit << "\n"
-      << "lcm:\n  channels: {points: NOSHM_POINTS, pose: NOSHM_POSE, roi: NOSHM_ROI, status: NOSHM_STATUS, "
-         "trajectory: NOSHM_TRAJECTORY, active_trajectory: NOSHM_ACTIVE}\n";
+  const fs::path dir = write_rover_config("NOSHM", rx.path(), "  configure: false\n", "", kChronyTime);
   const fs::path log = dir / "trajroid.log";
-  Child trajroid({"--config", (dir / "trajroid.yaml").string(), "--lcm-url", daemon_test::kTestLcmUrl}, log);
+  Child trajroid(trajroid_args(dir), log);
   EXPECT_TRUE(log_says(log,
                        "time.chrony_shm 13: no shared-memory segment 0x4E54503D: is chronyd running with `refclock "
                        "SHM 13` in its configuration"))

@@ -23,24 +23,13 @@ using daemon_test::counter;
 using daemon_test::Listener;
 namespace fs = std::filesystem;
 
-// A run folder with trajroid's configuration for `url` on channels `prefix`_*.
+// A run folder with trajroid's configuration for `url` on channels `prefix`_*: the receiver
+// configured, fixed RTK required.
 fs::path write_config(const std::string& prefix, const std::string& device, const std::string& url) {
-  const fs::path dir = fs::path(::testing::TempDir()) / (prefix + "_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  std::ofstream(dir / "trajectory.csv") << "0,0\n10,0\n";
-  std::ofstream(dir / "trajroid.yaml")
-      << "global_frame:\n  origin: {lat_deg: 45.0657, lon_deg: 7.6590, height_m: 300.0}\n"
-      << "trajectory:\n  file: trajectory.csv\n"
-      << "lidar:\n  data_port: 0\n  position_port: 0\n"
-      << "gnss:\n  device: " << device << "\n  configure: true\n  rate_hz: 1\n"
-      << "  corrections: {url: '" << url << "', gga_interval_s: 1, stall_s: 30}\n"
-      << "  max_correction_age_s: 2\n"
-      << "pose:\n  source: gnss\n  gnss_heading: {initial_heading_deg: 90}\n  require_rtk: fixed\n"
-      << "  max_extrapolation_s: 1.5\n"
-      << "lcm:\n  channels: {points: " << prefix << "_POINTS, pose: " << prefix << "_POSE, roi: " << prefix
-      << "_ROI, status: " << prefix << "_STATUS, trajectory: " << prefix << "_TRAJECTORY, active_trajectory: " << prefix
-      << "_ACTIVE}\n";
-  return dir;
+  return write_rover_config(prefix, device,
+                            "  configure: true\n  rate_hz: 1\n  corrections: {url: '" + url +
+                                "', gga_interval_s: 1, stall_s: 30}\n  max_correction_age_s: 2\n",
+                            "  require_rtk: fixed\n  max_extrapolation_s: 1.5\n");
 }
 
 bool wait_frames(Receiver& rx, std::size_t n, double seconds = 15.0) {
@@ -120,7 +109,7 @@ TEST(TrajroidCorrections, NtripCasterFramesReachTheReceiverExactlyOnceAcrossARes
       write_config(prefix, rx.path(), "ntrip://rover:s3cret@127.0.0.1:" + std::to_string(port) + "/F9T?version=1");
   Listener listener(prefix);
   const fs::path log = dir / "trajroid.log";
-  Child trajroid({"--config", (dir / "trajroid.yaml").string(), "--lcm-url", daemon_test::kTestLcmUrl}, log);
+  Child trajroid(trajroid_args(dir), log);
   ASSERT_TRUE(log_says(log, "corrections: connected to ntrip://rover:***@127.0.0.1:" + std::to_string(port)))
       << daemon_test::slurp(log);
   EXPECT_TRUE(log_says(log, "RTCM3 corrections accepted")) << daemon_test::slurp(log);
@@ -161,7 +150,7 @@ TEST(TrajroidCorrections, WrongCredentialsAreNamedAndNothingIsWritten) {
   const fs::path dir =
       write_config(prefix, rx.path(), "ntrip://rover:wrong@127.0.0.1:" + std::to_string(port) + "/F9T?version=1");
   const fs::path log = dir / "trajroid.log";
-  Child trajroid({"--config", (dir / "trajroid.yaml").string(), "--lcm-url", daemon_test::kTestLcmUrl}, log);
+  Child trajroid(trajroid_args(dir), log);
   EXPECT_TRUE(log_says(log, "refused by the caster: HTTP/1.0 401 Unauthorized")) << daemon_test::slurp(log);
   std::size_t corrupted = 0;
   caster.write(with_noise(rig.frames, 0, 20, corrupted));
@@ -188,7 +177,7 @@ TEST(TrajroidCorrections, TcpAndUdpStreamsReachTheReceiverExactly) {
     const fs::path dir = write_config(prefix, rx.path(), url);
     Listener listener(prefix);
     const fs::path log = dir / "trajroid.log";
-    Child trajroid({"--config", (dir / "trajroid.yaml").string(), "--lcm-url", daemon_test::kTestLcmUrl}, log);
+    Child trajroid(trajroid_args(dir), log);
     ASSERT_TRUE(log_says(log, kind == "tcp" ? "corrections: connected to tcp://" : "corrections: from udp://"))
         << daemon_test::slurp(log);
     std::size_t corrupted = 0;
@@ -216,7 +205,7 @@ TEST(TrajroidCorrections, AStreamThatIsNotRtcm3IsNamedAndNothingIsWritten) {
   const std::string url = "tcp://127.0.0.1:" + std::to_string(port);
   const fs::path dir = write_config(prefix, rx.path(), url);
   const fs::path log = dir / "trajroid.log";
-  Child trajroid({"--config", (dir / "trajroid.yaml").string(), "--lcm-url", daemon_test::kTestLcmUrl}, log);
+  Child trajroid(trajroid_args(dir), log);
   ASSERT_TRUE(log_says(log, "corrections: connected to tcp://")) << daemon_test::slurp(log);
   // Four seconds of the VN-100's output, a piece each second.
   for (int second = 0; second < 4; ++second) {
@@ -253,7 +242,7 @@ TEST(TrajroidCorrections, ARadioSerialPortReachesTheReceiverExactly) {
   const fs::path dir = write_config(prefix, rx.path(), url);
   Listener listener(prefix);
   const fs::path log = dir / "trajroid.log";
-  Child trajroid({"--config", (dir / "trajroid.yaml").string(), "--lcm-url", daemon_test::kTestLcmUrl}, log);
+  Child trajroid(trajroid_args(dir), log);
   // trajroid is up (its first status) and has opened the radio's port.
   ASSERT_TRUE(listener.wait_for([&] { return !listener.statuses.empty(); }, std::chrono::seconds(10)))
       << daemon_test::slurp(log);
@@ -283,7 +272,7 @@ TEST(TrajroidCorrections, LcmRtcmMessagesReachTheReceiverExactly) {
   const fs::path dir = write_config(prefix, rx.path(), "lcm://" + prefix + "_RTCM");
   Listener listener(prefix);
   const fs::path log = dir / "trajroid.log";
-  Child trajroid({"--config", (dir / "trajroid.yaml").string(), "--lcm-url", daemon_test::kTestLcmUrl}, log);
+  Child trajroid(trajroid_args(dir), log);
   ASSERT_TRUE(log_says(log, "corrections: from lcm://" + prefix + "_RTCM")) << daemon_test::slurp(log);
   std::size_t corrupted = 0;
   const Bytes bytes = with_noise(rig.frames, 0, 182, corrupted);

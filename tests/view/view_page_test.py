@@ -218,9 +218,14 @@ def main():
     print("PASS: screenshot kept as " + shot)
 
 
-if __name__ == "__main__":
+def run_main(main):
+    """Runs a test's main: an AssertionError is its failure, said in one line, exit 1."""
     try:
         main()
     except AssertionError as e:
         print("FAIL: %s" % e)
         sys.exit(1)
+
+
+if __name__ == "__main__":
+    run_main(main)

@@ -25,7 +25,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import webdriver  # noqa: E402
 from panel import panel_text  # noqa: E402
-from view_page_test import SKIP, check, need, start_view, wait_for  # noqa: E402
+from view_page_test import SKIP, check, need, run_main, start_view, wait_for  # noqa: E402
 
 
 def data_file(relative):
@@ -166,8 +166,4 @@ def main():
 
 
 if __name__ == "__main__":
-    try:
-        main()
-    except AssertionError as e:
-        print("FAIL: %s" % e)
-        sys.exit(1)
+    run_main(main)

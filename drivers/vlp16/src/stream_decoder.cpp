@@ -77,13 +77,6 @@ bool may_complete_frame(std::span<const std::uint8_t> packet, std::uint16_t cut_
          azimuth_gap(cut_cdeg, first) <= kFrameEndMargin_cdeg;
 }
 
-std::uint64_t StreamCounters::rejected_total() const noexcept {
-  std::uint64_t total = 0;
-  for (const std::uint64_t n : rejected)
-    total += n;
-  return total;
-}
-
 StreamDecoder::StreamDecoder(const Calibration& calibration, StreamOptions options)
     : options_(options), model_(options.detect_model ? std::nullopt : std::optional<Model>(options.model)) {
   for (std::size_t m = 0; m < kModelCount; ++m) {
@@ -99,64 +92,6 @@ StreamDecoder::StreamDecoder(const Calibration& calibration, StreamOptions optio
   held_.reserve(ModelCheck::kMaxUndecided);
   frame_.points.reserve(kFrameReserve);
   carried_.reserve(kPointsPerPacket);
-}
-
-void StreamDecoder::on_data_packet(std::span<const std::uint8_t> payload, std::int64_t receive_time_ns, FrameSink& sink,
-                                   const DecodedPacket* decoded) {
-  ++counters_.data_packets;
-  // A packet decoded ahead was valid there (its bytes are the same).
-  const PacketError error = decoded != nullptr ? PacketError::kNone : validate_data_packet(payload);
-  if (error != PacketError::kNone) {
-    ++counters_.rejected[static_cast<std::size_t>(error)];
-    if (error == PacketError::kUnsupportedProduct) (void)model_.check(payload);  // records the reason
-    return;
-  }
-  switch (model_.check(payload)) {
-    case ModelCheck::Verdict::kDecided:
-      current_ = decoders_[static_cast<std::size_t>(model_.model())].get();
-      for (const HeldPacket& held : held_)
-        accept(held.bytes, held.receive_time_ns, sink, nullptr);
-      held_.clear();
-      // Points decoded ahead by another model's decoder are decoded again here.
-      accept(payload, receive_time_ns, sink,
-             decoded != nullptr && decoded->model == model_.model() ? decoded : nullptr);
-      return;
-    case ModelCheck::Verdict::kUndecided:
-      if (held_.size() < ModelCheck::kMaxUndecided) {
-        HeldPacket& held = held_.emplace_back();
-        std::copy(payload.begin(), payload.end(), held.bytes.begin());
-        held.receive_time_ns = receive_time_ns;
-        return;
-      }
-      break;  // cannot happen: the check decides within kMaxUndecided packets
-    case ModelCheck::Verdict::kRejected:
-      break;
-  }
-  counters_.rejected[static_cast<std::size_t>(PacketError::kUnsupportedProduct)] += 1 + held_.size();
-  held_.clear();
-}
-
-const PacketDecoder* StreamDecoder::decoder_for(std::span<const std::uint8_t> packet) const noexcept {
-  if (packet.size() != kDataPacketBytes) return nullptr;
-  std::optional<Model> model = unambiguous_model(vlp16::product_id(packet));
-  if (!model && vlp16::product_id(packet) == kProductHdl32e && !options_.detect_model) model = options_.model;
-  return model ? decoders_[static_cast<std::size_t>(*model)].get() : nullptr;
-}
-
-void StreamDecoder::on_position_packet(std::span<const std::uint8_t> payload) {
-  ++counters_.position_packets;
-  PositionPacket packet;
-  if (!parse_position_packet(payload, packet)) {
-    ++counters_.position_wrong_size;
-    return;
-  }
-  ++counters_.nmea[static_cast<std::size_t>(packet.nmea)];
-  last_position_ = packet;
-  if (packet.nmea == NmeaError::kNone) {
-    if (!first_rmc_) first_rmc_ = packet;
-    last_rmc_ = packet;
-  }
-  utc_clock_.on_position(packet);
 }
 
 std::int64_t StreamDecoder::packet_time_ns(std::uint32_t toh_us, std::int64_t receive_time_ns, double period_us) {
