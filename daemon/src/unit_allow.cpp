@@ -3,6 +3,7 @@
 #include <arpa/inet.h>
 #include <ifaddrs.h>
 #include <net/if.h>
+#include <netdb.h>
 #include <netinet/in.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
@@ -12,6 +13,8 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include "trajroi/corrections/corrections_url.hpp"
 
 namespace trajroi::daemon {
 namespace {
@@ -46,6 +49,52 @@ std::string char_device_class(unsigned major_number, const std::string& node_nam
 
 void add_unique(std::vector<std::string>& list, const std::string& entry) {
   if (std::find(list.begin(), list.end(), entry) == list.end()) list.push_back(entry);
+}
+
+// gnss.corrections: the caster's or server's addresses (its name resolved now: the unit is set
+// at each start), a radio's serial device; UDP and LCM senders are not known here.
+template <class AddDevice>
+void corrections_allow(const DaemonConfig& config, UnitAllowLists& lists, const AddDevice& add_device) {
+  const std::string& url = config.gnss_corrections.url;
+  if (url.empty()) return;
+  corrections::CorrectionsUrl u;
+  try {
+    u = corrections::parse_corrections_url(url);
+  } catch (const std::exception&) {
+    return;  // the configuration check names it
+  }
+  using Kind = corrections::CorrectionsUrl::Kind;
+  if (u.kind == Kind::kNtrip || u.kind == Kind::kTcp) {
+    addrinfo hints{};
+    hints.ai_family = AF_INET;
+    hints.ai_socktype = SOCK_STREAM;
+    addrinfo* found = nullptr;
+    const int rc = getaddrinfo(u.ntrip.host.c_str(), nullptr, &hints, &found);
+    if (rc != 0) {
+      lists.problems.push_back("gnss.corrections.url: cannot resolve " + u.ntrip.host + " now (" + gai_strerror(rc) +
+                               "): the caster is not allowed; restart the unit once it resolves");
+      return;
+    }
+    std::string joined;
+    for (const addrinfo* a = found; a != nullptr; a = a->ai_next) {
+      char text[INET_ADDRSTRLEN] = "";
+      inet_ntop(AF_INET, &reinterpret_cast<const sockaddr_in*>(a->ai_addr)->sin_addr, text, sizeof text);
+      if (std::find(lists.ip_allow.begin(), lists.ip_allow.end(), text) == lists.ip_allow.end()) {
+        lists.ip_allow.emplace_back(text);
+        joined.append(joined.empty() ? "" : " ").append(text);
+      }
+    }
+    freeaddrinfo(found);
+    if (!joined.empty()) lists.reasons.push_back("the corrections' server " + u.redacted() + " at " + joined);
+  } else if (u.kind == Kind::kUdp) {
+    lists.problems.push_back("gnss.corrections.url " + u.redacted() +
+                             ": the base station's address is not known here: outside the private ranges, admit it "
+                             "with a drop-in of your own (IPAddressAllow=)");
+  } else if (u.kind == Kind::kSerial) {
+    DaemonConfig::Serial radio;
+    radio.device = u.device;
+    add_device(radio, "gnss.corrections.url (radio)");
+  }
 }
 
 }  // namespace
@@ -105,6 +154,7 @@ UnitAllowLists unit_allow_lists(const DaemonConfig& config, const std::string& l
   if (config.pose_source == PoseSource::kGnssImu || config.pose_source == PoseSource::kGnss)
     add_device(config.gnss, "gnss.device");
   if (config.pose_source == PoseSource::kGnssImu) add_device(config.imu, "imu.device");
+  corrections_allow(config, lists, add_device);
   return lists;
 }
 

@@ -60,4 +60,28 @@ TEST(UnitAllow, SerialDevicesAreAllowedByNodeAndClassALinkByItsNodeAMissingOneIs
   EXPECT_TRUE(trajroi::daemon::unit_allow_lists(c, "udpm://239.255.76.67:7667?ttl=0", {}).device_allow.empty());
 }
 
+// gnss.corrections under the unit's IP filter: the caster's address is admitted (a name
+// resolved at the unit's start), a radio's device is allowed like the GNSS port, a UDP
+// base station, whose address is not known, is said.
+TEST(UnitAllow, TheCorrectionsServerAndARadioAreAllowedAUdpBaseIsSaid) {
+  DaemonConfig c;
+  c.lidar.sensor_address = "10.0.0.100";
+  c.gnss_corrections.url = "ntrip://rover:s3cret@203.0.113.7:2101/MOUNT";
+  UnitAllowLists l = trajroi::daemon::unit_allow_lists(c, "memq://", {});
+  EXPECT_EQ(l.ip_allow, (std::vector<std::string>{"localhost", "10.0.0.100", "203.0.113.7"}));
+  ASSERT_FALSE(l.reasons.empty());
+  EXPECT_EQ(l.reasons.back(), "the corrections' server ntrip://rover:***@203.0.113.7:2101/MOUNT at 203.0.113.7");
+  c.gnss_corrections.url = "tcp://localhost:9001";  // resolved: 127.0.0.1
+  l = trajroi::daemon::unit_allow_lists(c, "memq://", {});
+  EXPECT_TRUE(has(l.ip_allow, "127.0.0.1"));
+  c.gnss_corrections.url = "serial:///dev/null?baud=57600";  // a character device standing in for the radio
+  l = trajroi::daemon::unit_allow_lists(c, "memq://", {});
+  EXPECT_TRUE(has(l.device_allow, "/dev/null rw"));
+  EXPECT_TRUE(has(l.device_allow, "char-mem rw"));
+  c.gnss_corrections.url = "udp://:9000";
+  l = trajroi::daemon::unit_allow_lists(c, "memq://", {});
+  ASSERT_EQ(l.problems.size(), 1u);
+  EXPECT_NE(l.problems[0].find("the base station's address is not known here"), std::string::npos) << l.problems[0];
+}
+
 }  // namespace
