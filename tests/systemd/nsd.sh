@@ -1,4 +1,4 @@
-# A real systemd, booted as PID 1 of private PID, mount and network namespaces, for the
+# A real systemd, booted as PID 1 of private PID, mount, network and IPC namespaces, for the
 # service tests. Source this file; then:
 #   nsd_boot              boot it (waits until it is running); ends it at exit
 #   nsd COMMAND…          run a command inside (its PID, mount and network namespaces)
@@ -35,7 +35,7 @@ nsd_boot() {
   local addresses="${NSD_ADDRESSES:-}"
   # The script PID 1 runs: the private /tmp and /run first (and checked empty), then the
   # network, then systemd. Any failure ends it before systemd starts.
-  unshare --pid --fork --mount-proc --mount --propagation private --net \
+  unshare --pid --fork --mount-proc --mount --propagation private --net --ipc \
     /bin/bash -c '
       set -euo pipefail
       mount -t tmpfs tmpfs /tmp
@@ -94,7 +94,7 @@ nsd_boot() {
 }
 
 nsd() {
-  nsenter -t "$NSD_PID1" -p -m -n "$@"
+  nsenter -t "$NSD_PID1" -p -m -n -i "$@"
 }
 
 nsd_install_unit() {

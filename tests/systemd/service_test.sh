@@ -2,7 +2,7 @@
 # trajroid under a real systemd (PID 1 of private PID, mount and network namespaces, see
 # nsd.sh), with the unit as installed. One case per run:
 #   service_test.sh CASE UNIT CONFIG_DIR TRAJROI WORK PYTHONPATH DATA_DIR
-# CASE: idle_then_stop | frozen_is_restarted | reload | bad_config | live
+# CASE: idle_then_stop | frozen_is_restarted | reload | bad_config | live | rtk
 set -euo pipefail
 case_name=$1 unit_file=$2 config_dir=$3 trajroi=$4 work=$5 python_path=$6 data_dir=$7
 here=$(cd "$(dirname "$0")" && pwd)
@@ -261,6 +261,107 @@ YAML
     fail "the ROIs are not placed on the reloaded trajectory (headings $heading_min … $heading_max°, expected 85.4°)"
   grep -q "gnss: .*opened\|gnss: reading" "$work/feed.log" || true
   echo "sensor behind the firewall: $firewall"
+  ;;
+
+rtk)
+  # RTK corrections and the chrony feed through the unit's sandbox: RTKLIB's str2str as an
+  # NTRIP caster at 10.0.0.50 (admitted by the allow-list step, as a caster named in the
+  # configuration), serving the RTCM3 frames of a real ZED-F9T stream; the u-blox a pseudo-
+  # terminal playing a real ZED-F9R log (rtk_peer.py); chronyd -Q making the SHM refclock the
+  # DynamicUser writes into (perm=0666), which RemoveIPC= must leave in place at stop.
+  rover_log=$data_dir/ublox/gpsd/ublox-zed-f9r.log
+  base_log=$data_dir/ublox/gpsd/ublox-zed-f9t-rtcm3.log
+  for f in "$rover_log" "$base_log"; do
+    if [ ! -f "$f" ]; then
+      echo "SKIP: $f is missing (TRAJROI_DATA_DIR)" >&2
+      [ "${CI:-}" = true ] && exit 1
+      exit 77
+    fi
+  done
+  for tool in str2str /usr/sbin/chronyd lcm-logger; do
+    if ! command -v "$tool" >/dev/null; then
+      echo "SKIP: $tool is missing (scripts/install-deps.sh installs rtklib, chrony, liblcm-bin)" >&2
+      [ "${CI:-}" = true ] && exit 1
+      exit 77
+    fi
+  done
+  peer() { nsd "${PYTHON:-python3}" "$here/rtk_peer.py" "$@"; }
+  segment_made() { nsd ipcs -m | grep -q 0x4e545032; }
+  every_frame_read() { "${PYTHON:-python3}" "$here/rtk_peer.py" check "$work/written.bin" "$base_log" >/dev/null; }
+  printf '0,0\n10,0\n' >"$work/trajectory.csv"
+  cat >"$work/trajroid.yaml" <<YAML
+global_frame:
+  origin: {lat_deg: 45.0657, lon_deg: 7.6590, height_m: 300.0}
+trajectory:
+  file: trajectory.csv
+lidar:
+  sensor_address: 10.0.0.100
+gnss:
+  device: $work/gnss
+  configure: true
+  rate_hz: 1
+  corrections: {url: 'ntrip://rover:s3cret@10.0.0.50:2101/F9T', gga_interval_s: 1}
+pose:
+  source: gnss
+  gnss_heading: {initial_heading_deg: 90}
+  require_rtk: float
+time:
+  chrony_shm: 2
+YAML
+  printf 'refclock SHM 2:perm=0666 refid GNSS poll 0 filter 3\npidfile %s/chronyd.pid\n' "$work" >"$work/chrony.conf"
+  chmod 644 "$work"/*
+  export NSD_ADDRESSES=10.0.0.50
+  nsd_boot
+  pids=()
+  nsd_on_exit() {
+    local p
+    for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+    true
+  }
+  install_unit "$work/trajroid.yaml"
+  nsd /usr/sbin/chronyd -Q -d -t 45 -u root -f "$work/chrony.conf" >"$work/chronyd.log" 2>&1 &
+  chronyd_pid=$!
+  pids+=("$chronyd_pid")
+  nsd str2str -in tcpsvr://:2102 -out "ntripc://rover:s3cret@:2101/F9T" >"$work/str2str.log" 2>&1 &
+  pids+=($!)
+  peer rover "$rover_log" "$work/gnss" "$work/written.bin" 40 >"$work/rover.log" 2>&1 &
+  pids+=($!)
+  wait_for 10 test -L "$work/gnss" || fail "no receiver: $(cat "$work/rover.log")"
+  nsd chgrp dialout "$(readlink -f "$work/gnss")"
+  wait_for 10 segment_made || fail "chronyd made no SHM 2: $(cat "$work/chronyd.log")"
+  nsd timeout -s INT 30 lcm-logger --quiet "$work/out.lcmlog" >"$work/logger.log" 2>&1 &
+  pids+=($!)
+  nsd systemctl start trajroid.service || fail "start"
+  echo "allow-lists set at start:"
+  nsd journalctl -u trajroid.service --no-pager -o cat | grep "trajroid.service: allowing" | sed 's/^/  /'
+  echo "  IPAddressAllow=$(show IPAddressAllow)"
+  [[ " $(show IPAddressAllow) " == *" 10.0.0.50/32 "* || " $(show IPAddressAllow) " == *" 10.0.0.50 "* ]] ||
+    fail "the caster's address is not admitted: $(show IPAddressAllow)"
+  wait_for 15 journal_has "corrections: connected to ntrip://rover:\*\*\*@10.0.0.50:2101/F9T" ||
+    fail "not connected to the caster"
+  peer base "$base_log" 10.0.0.50:2102 || fail "the base could not reach str2str's input"
+  wait_for 15 every_frame_read ||
+    fail "not every frame reached the receiver: $("${PYTHON:-python3}" "$here/rtk_peer.py" check "$work/written.bin" "$base_log")"
+  wait_for 10 journal_has "RTK float" || fail "the RTK solution is not named"
+  # chronyd -Q ends once it has measured: "System clock wrong by X seconds".
+  wait "$chronyd_pid" || fail "chronyd: $(cat "$work/chronyd.log")"
+  chrony_offset=$(sed -n 's/.*System clock wrong by \(-\?[0-9.]*\) seconds.*/\1/p' "$work/chronyd.log" | tail -1)
+  [ -n "$chrony_offset" ] || fail "chronyd measured nothing: $(cat "$work/chronyd.log")"
+  nsd systemctl stop trajroid.service
+  [ "$(show Result)" = success ] || fail "result $(show Result) at stop"
+  # RemoveIPC= removes the dynamic user's IPC objects: chronyd's segment is not one of them.
+  segment_made || fail "the SHM segment went with trajroid's stop (RemoveIPC=)"
+  nsd journalctl -u trajroid.service --no-pager -o cat | grep -q s3cret && fail "the password reached the journal"
+  summary=$(PYTHONPATH="$python_path" "${PYTHON:-python3}" "$here/log_summary.py" "$work/out.lcmlog") ||
+    fail "the LCM log does not decode with the Python types"
+  "${PYTHON:-python3}" "$here/rtk_peer.py" check "$work/written.bin" "$base_log"
+  echo "$summary" | grep "^last_" | sed 's/^/  status: /'
+  trajroid_offset=$(awk '/^last_host_minus_gnss_utc_s/ {print $2}' <<<"$summary")
+  echo "chronyd -Q: host clock wrong by $chrony_offset s; trajroid's status: host − GNSS UTC $trajroid_offset s"
+  # chronyd says the correction it would make (GNSS − host): the opposite of trajroid's figure.
+  awk -v a="$chrony_offset" -v b="$trajroid_offset" 'BEGIN { d = a + b; exit !(d < 0.05 && d > -0.05) }' ||
+    fail "chronyd's offset is not trajroid's"
+  grep -q "^last_rtk_solution 1" <<<"$summary" || fail "the status does not report RTK float"
   ;;
 
 *)
