@@ -82,6 +82,63 @@ class OpenMaps {
   std::vector<std::pair<std::string, MapReader>> open_;
 };
 
+// `lidars:` (a list, each entry the keys of `lidar:` and a name) or the one `lidar:`.
+void read_lidars(MapReader& root, DaemonConfig& c, const std::filesystem::path& dir) {
+  const ConfigSection* section = section_named("lidar");
+  if (root.has("lidars")) {
+    root.require(!root.has("lidar"), "lidars", "give either lidar: (one sensor) or lidars: (a list), not both");
+    c.lidars.clear();
+    root.each("lidars", [&](MapReader& item) {
+      DaemonConfig one;
+      one.lidar.name = item.text("name");
+      item.require(!one.lidar.name.empty() && one.lidar.name.size() <= 32 &&
+                       one.lidar.name.find_first_not_of(
+                           "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") == std::string::npos,
+                   "name", "must be 1 … 32 letters, digits, '_' or '-'");
+      for (const ConfigKey& key : config_keys()) {
+        const auto [map_path, name] = split_key(key.path);
+        if (map_path == "lidar") key.read(item, name, one, dir);
+      }
+      if (section != nullptr && section->check) section->check(item, one);
+      for (const DaemonConfig::Lidar& before : c.lidars)
+        item.require(before.name != one.lidar.name, "name", "is the name of another sensor");
+      c.lidars.push_back(one.lidar);
+    });
+    root.require(!c.lidars.empty() && c.lidars.size() <= kMaxLidars, "lidars",
+                 "must list 1 … " + std::to_string(kMaxLidars) + " sensors");
+    c.lidar = c.lidars.front();
+  } else {
+    c.lidars = {c.lidar};
+  }
+  // Sensors on one port are told apart by their addresses: each must have its own.
+  for (std::size_t i = 0; i < c.lidars.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      const DaemonConfig::Lidar& a = c.lidars[j];
+      const DaemonConfig::Lidar& b = c.lidars[i];
+      const std::string both = "lidars: " + a.name + " and " + b.name;
+      const bool same_data = a.data_port == b.data_port, same_position = a.position_port == b.position_port;
+      if (a.data_port == b.position_port || a.position_port == b.data_port) {
+        root.fail("lidars", both + ": one's data port is the other's position port");
+      }
+      if (same_data != same_position || (same_data && a.bind_address != b.bind_address)) {
+        root.fail("lidars", both +
+                                " share one port but not the other (or not the bind_address): sensors on one "
+                                "port share both ports and the address they bind");
+      }
+      if (!same_data) continue;
+      if (a.sensor_address.empty() || b.sensor_address.empty()) {
+        root.fail("lidars", both + " share UDP ports " + std::to_string(a.data_port) + "/" +
+                                std::to_string(a.position_port) +
+                                " without sensor_address: give each its address, so that their packets are told apart");
+      }
+      if (a.sensor_address == b.sensor_address) {
+        root.fail("lidars", both + " share UDP port " + std::to_string(a.data_port) + " and sensor_address " +
+                                a.sensor_address + ": one sender cannot be two sensors");
+      }
+    }
+  }
+}
+
 std::string markdown_cell(std::string_view text) {
   std::string out;
   for (const char ch : text) {
@@ -173,6 +230,7 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::filesystem::p
     key.read(maps.at(map_path), name, c, dir);
   }
   maps.close_all();
+  read_lidars(root, c, dir);
   root.finish();
   return c;
 }
@@ -181,6 +239,18 @@ std::string describe(const DaemonConfig& c) {
   std::string out;
   for (const ConfigKey& key : config_keys())
     out.append(key.path).append(": ").append(key.show(c)).append("\n");
+  if (c.lidars.size() > 1) {
+    for (std::size_t i = 0; i < c.lidars.size(); ++i) {
+      DaemonConfig one = c;
+      one.lidar = c.lidars[i];
+      const std::string at = "lidars[" + std::to_string(i) + "].";
+      out.append(at).append("name: ").append(one.lidar.name).append("\n");
+      for (const ConfigKey& key : config_keys()) {
+        if (key.path.starts_with("lidar."))
+          out.append(at).append(key.path.substr(6)).append(": ").append(key.show(one)).append("\n");
+      }
+    }
+  }
   return out;
 }
 

@@ -292,9 +292,17 @@ std::vector<ConfigSection> make_sections() {
   std::vector<ConfigSection> s;
   s.push_back({"global_frame", "The global frame", "ENU (x east, y north, z up) about an origin. Required.", true, {}});
   s.push_back({"trajectory", "The trajectory", "The active trajectory at start. Required.", true, {}});
-  s.push_back({"lidar", "The LiDAR", "A Velodyne VLP-16 on UDP.", false, [](MapReader& m, const DaemonConfig& c) {
+  s.push_back({"lidar", "The LiDAR",
+               "A Velodyne LiDAR on UDP (VLP-16, Puck LITE / Hi-Res, VLP-32C, HDL-32E). Several: lidars:, a list of "
+               "these maps, each with a name.",
+               false, [](MapReader& m, const DaemonConfig& c) {
                  m.require(c.lidar.max_range_m > c.lidar.min_range_m, "max_range_m", "must exceed min_range_m");
                }});
+  s.push_back({"lidar_merge",
+               "Several LiDARs",
+               "With lidars: (a list of lidar: maps, each with a name): how their sweeps are merged.",
+               false,
+               {}});
   s.push_back({"gnss",
                "The GNSS receiver",
                "A u-blox receiver on a serial port: UBX NAV-PVT (+ NAV-HPPOSLLH) at 5–10 Hz.",

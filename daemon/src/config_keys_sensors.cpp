@@ -180,6 +180,23 @@ void add_sensor_keys(std::vector<ConfigKey>& k) {
       "false: the ports are this daemon's alone (a second reader fails at start, naming the port); "
       "true: SO_REUSEADDR, for multicast",
       [](auto& c) -> auto& { return c.lidar.share_ports; }));
+  // ---- lidar_merge (several LiDARs)
+  k.push_back(real_key(
+      "lidar_merge.max_wait_s", "number > 0",
+      "after the first sensor's sweep of a window, the others' are waited for this long at most (input time)",
+      Sign::kPositive, [](auto& c) -> auto& { return c.lidar_merge.max_wait_s; }));
+  k.push_back(real_key(
+      "lidar_merge.silent_s", "number > 0",
+      "a sensor with no sweep for this long is silent: named in the log and the status, and not waited for",
+      Sign::kPositive, [](auto& c) -> auto& { return c.lidar_merge.silent_s; }));
+  k.push_back({"lidar_merge.publish", "merged | per_sensor",
+               "merged: one points_t per window with every sensor's kept points; per_sensor: each sweep alone", false,
+               [](MapReader& m, std::string_view key, DaemonConfig& c, const Dir&) {
+                 c.lidar_merge.per_sensor =
+                     m.choice(key, {"merged", "per_sensor"}, c.lidar_merge.per_sensor ? "per_sensor" : "merged") ==
+                     "per_sensor";
+               },
+               [](const DaemonConfig& c) { return std::string(c.lidar_merge.per_sensor ? "per_sensor" : "merged"); }});
   // ---- gnss, imu
   add_serial_keys(k, &DaemonConfig::gnss, true);
   k.push_back({"gnss.antenna", "[x, y, z]",

@@ -74,6 +74,7 @@ std::vector<HealthLine> HealthMonitor::update(const StatusSnapshot& s) {
     history_.pop_front();
 
   lidar(s, out);
+  lidar_sensors(s, out);
   serial_ports(s, out);
   localization(s, out);
   minute_summary(s, out);
@@ -91,6 +92,32 @@ std::vector<HealthLine> HealthMonitor::update(const StatusSnapshot& s) {
   clocks(s, out);
   update_state(s, previous);
   return out;
+}
+
+std::string HealthMonitor::lidar_names(std::uint32_t mask) const {
+  std::string names;
+  for (std::size_t i = 0; i < config_.lidars.size(); ++i) {
+    if ((mask & (1U << i)) == 0) continue;
+    const DaemonConfig::Lidar& l = config_.lidars[i];
+    names += (names.empty() ? "" : ", ") + l.name + " (" +
+             (l.sensor_address.empty() ? std::string("any sender") : l.sensor_address) + " → UDP " +
+             std::to_string(l.data_port) + ")";
+  }
+  return names;
+}
+
+void HealthMonitor::lidar_sensors(const StatusSnapshot& s, std::vector<HealthLine>& out) {
+  if (s.silent_lidars == silent_lidars_) return;
+  const std::uint32_t fell = s.silent_lidars & ~silent_lidars_;
+  const std::uint32_t back = silent_lidars_ & ~s.silent_lidars;
+  if (fell != 0) {
+    out.push_back({HealthLine::Level::kWarning,
+                   sprintf_text("lidar: %s silent: no sweep for more than %.2f s (lidar_merge.silent_s); the other "
+                                "sensors' sweeps are published without it (its power, cable, address or port?)",
+                                lidar_names(fell).c_str(), config_.lidar_merge.silent_s)});
+  }
+  if (back != 0) out.push_back({HealthLine::Level::kInfo, "lidar: " + lidar_names(back) + " sends sweeps again"});
+  silent_lidars_ = s.silent_lidars;
 }
 
 // Live only: in a replay the recording's receiver and sensor are not now.
@@ -219,6 +246,7 @@ void HealthMonitor::update_state(const StatusSnapshot& s, const StatusSnapshot& 
   } else if (active_[kLidarSilent] || (live_ && accepted_packets(s) == 0)) {
     add(sprintf_text("waiting for LiDAR data on UDP port %u", l.data_port));
   }
+  if (s.silent_lidars != 0) add("LiDAR " + lidar_names(s.silent_lidars) + ": silent, not merged");
   bool pose_input_fault = false;
   for (const std::string& serial : serial_state_) {
     if (!serial.empty()) add(serial), pose_input_fault = true;

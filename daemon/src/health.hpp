@@ -65,6 +65,9 @@ class HealthMonitor {
   void serial_ports(const StatusSnapshot& s, std::vector<HealthLine>& out);
   void localization(const StatusSnapshot& s, std::vector<HealthLine>& out);
   void minute_summary(const StatusSnapshot& s, std::vector<HealthLine>& out);
+  // Several LiDARs: each one that falls silent or sends again, said.
+  void lidar_sensors(const StatusSnapshot& s, std::vector<HealthLine>& out);
+  [[nodiscard]] std::string lidar_names(std::uint32_t mask) const;
   // The host clock against GNSS time and the VLP-16's; the VLP-16's PPS.
   void clocks(const StatusSnapshot& s, std::vector<HealthLine>& out);
   // The state in words, from the faults now active.
@@ -86,6 +89,7 @@ class HealthMonitor {
   bool active_[kFaultCount] = {};
   bool lidar_pps_locked_once_ = false;
   std::int8_t lidar_model_said_ = -1;
+  std::uint32_t silent_lidars_ = 0;  // several LiDARs: those said to be silent
   // Each serial port's fault in a few words for the state ("NMEA text, no UBX"): GNSS, IMU.
   std::string serial_state_[2];
   StatusSnapshot minute_start_;  // the mixed LiDAR port's summary

@@ -41,7 +41,7 @@ bool wake_now(const inputs::InputItem& item, std::uint16_t cut_cdeg, std::uint16
 // says why), nor when that ring is full (the processing thread then decodes it itself: the same
 // points either way).
 bool decode_ahead(const Pipeline& pipeline, InputLane& lane, const InputSlot& slot) {
-  if (slot.stream != inputs::Stream::kLidarData || pipeline.lidar_stream == nullptr || !lane.decoded) return false;
+  if (slot.stream != inputs::Stream::kLidarData || pipeline.processor == nullptr || !lane.decoded) return false;
   // Only while the processing thread is behind (busy, and items wait in the ring; items this
   // thread holds back while it sleeps do not count): otherwise it decodes the packet itself, as
   // at real time, where decoding ahead would only add the copy between the cores. The work goes
@@ -50,7 +50,11 @@ bool decode_ahead(const Pipeline& pipeline, InputLane& lane, const InputSlot& sl
   if (pipeline.processing_waits.load(std::memory_order_relaxed) || lane.ring->size() < backlog) return false;
   const std::span<const std::uint8_t> packet(slot.bytes.data(), slot.size);
   if (vlp16::validate_data_packet(packet) != vlp16::PacketError::kNone) return false;
-  const vlp16::PacketDecoder* decoder = pipeline.lidar_stream->decoder_for(packet);
+  const int sensor =
+      pipeline.processor->lane_for(inputs::InputItem{slot.stream, packet, slot.receive_ns, slot.sender, slot.port});
+  if (sensor < 0) return false;
+  const vlp16::PacketDecoder* decoder =
+      pipeline.processor->lidar_stream(static_cast<std::size_t>(sensor)).decoder_for(packet);
   if (decoder == nullptr) return false;
   return lane.decoded->try_push([&](vlp16::DecodedPacket& d) {
     d.tag = slot.seq;
@@ -134,6 +138,8 @@ void input_loop(Pipeline& pipeline, InputLane& lane) {
         slot.receive_ns = item.receive_ns;
         slot.stream = item.stream;
         slot.size = static_cast<std::uint16_t>(piece.size());
+        slot.sender = item.sender;
+        slot.port = item.port;
         std::copy(piece.begin(), piece.end(), slot.bytes.begin());
         slot.arrival_ns = host::monotonic_ns();  // before decoding: the latency figures include it
         slot.seq = pipeline.sequence.fetch_add(1, std::memory_order_relaxed);

@@ -1,5 +1,7 @@
 #include "message_sender.hpp"
 
+#include "trajroi/pipeline/sweep_processor.hpp"
+
 namespace trajroi::daemon {
 
 MessageSender::MessageSender(Outlet& outlet, const DaemonConfig& config) : outlet_(outlet), config_(config) {}
@@ -7,7 +9,8 @@ MessageSender::MessageSender(Outlet& outlet, const DaemonConfig& config) : outle
 void MessageSender::make_resident() {
   // A page over for the head, whose size is that of an empty sweep's.
   daemon::encode_points(pipeline::Sweep{}, config_, points_, points_encoded_);
-  points_encoded_.resize(points_encoded_.size() + 4096 + config_.buffers.max_points_per_sweep * kEncodedBytesPerPoint);
+  points_encoded_.resize(points_encoded_.size() + 4096 +
+                         pipeline::sweep_points_capacity(config_) * kEncodedBytesPerPoint);
   points_encoded_.clear();
   if (config_.outputs.raw_points) {
     raw_encoded_.resize(points_encoded_.capacity());
@@ -34,7 +37,7 @@ void MessageSender::send_points() {
 }
 
 void MessageSender::send_raw_points(const pipeline::Sweep& s) {
-  daemon::encode_points(s, s.raw, config_, points_, raw_encoded_);
+  daemon::encode_points(s, s.raw, {}, config_, points_, raw_encoded_);
   outlet_.publish(config_.lcm.raw_points, raw_encoded_);
 }
 

@@ -101,8 +101,25 @@ void fill_pose(const pipeline::SweepHeader& sweep, const DaemonConfig& config, t
   out.h_acc_m = gnss ? sweep.fix.h_acc_m : std::numeric_limits<double>::quiet_NaN();
 }
 
+// The sensors' names, and those the merge did not get.
+void fill_sensors(const pipeline::SweepHeader& sweep, const DaemonConfig& config, bool told, trajroi::points_t& out) {
+  out.sensor_names.clear();
+  if (told) {
+    for (const DaemonConfig::Lidar& l : config.lidars)
+      out.sensor_names.push_back(l.name);
+  }
+  out.num_sensors = static_cast<std::int8_t>(out.sensor_names.size());
+  out.missing.clear();
+  for (std::size_t i = 0; i < config.lidars.size(); ++i) {
+    if ((sweep.missing & (1U << i)) == 0) continue;
+    if (!out.missing.empty()) out.missing += ", ";
+    out.missing += config.lidars[i].name;
+  }
+}
+
 void fill_points(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::points_t& out) {
   fill_points_head(sweep, config, out);
+  fill_sensors(sweep, config, true, out);
   out.num_points = static_cast<std::int32_t>(sweep.size());
   copy_into(out.x, sweep.x);
   copy_into(out.y, sweep.y);
@@ -111,16 +128,20 @@ void fill_points(const pipeline::Sweep& sweep, const DaemonConfig& config, trajr
   copy_into(out.ring, sweep.ring);
   copy_into(out.return_type, sweep.return_type);
   copy_into(out.time_offset_ns, sweep.time_offset_ns);
+  out.sensor.assign(sweep.size(), 0);
+  std::copy(sweep.sensor_index.begin(), sweep.sensor_index.end(), out.sensor.begin());
 }
 
 void encode_points(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::points_t& head,
                    std::vector<std::uint8_t>& out) {
-  encode_points(sweep, sweep, config, head, out);
+  encode_points(sweep, sweep, sweep.sensor_index, config, head, out);
 }
 
-void encode_points(const pipeline::SweepHeader& sweep, const pipeline::PointColumns& points, const DaemonConfig& config,
-                   trajroi::points_t& head, std::vector<std::uint8_t>& out) {
+void encode_points(const pipeline::SweepHeader& sweep, const pipeline::PointColumns& points,
+                   std::span<const std::uint8_t> sensor_index, const DaemonConfig& config, trajroi::points_t& head,
+                   std::vector<std::uint8_t>& out) {
   fill_points_head(sweep, config, head);
+  fill_sensors(sweep, config, config.lidars.size() == 1 || sensor_index.size() == points.size(), head);
   head.num_points = 0;  // the arrays empty: num_points is the head's last field, patched below
   head.x.clear();
   head.y.clear();
@@ -129,6 +150,7 @@ void encode_points(const pipeline::SweepHeader& sweep, const pipeline::PointColu
   head.ring.clear();
   head.return_type.clear();
   head.time_offset_ns.clear();
+  head.sensor.clear();
   const auto head_size = static_cast<std::size_t>(head.getEncodedSize());
   const std::size_t n = points.size();
   out.resize(head_size + n * kEncodedBytesPerPoint);
@@ -142,7 +164,13 @@ void encode_points(const pipeline::SweepHeader& sweep, const pipeline::PointColu
   p = std::copy(points.intensity.begin(), points.intensity.end(), p);
   p = std::copy(points.ring.begin(), points.ring.end(), p);
   p = std::copy(points.return_type.begin(), points.return_type.end(), p);
-  (void)store_be32_array(p, points.time_offset_ns);
+  p = store_be32_array(p, points.time_offset_ns);
+  // The sensor of each point: all the one LiDAR's (0), or as the merge marked them.
+  if (sensor_index.size() == n) {
+    std::copy(sensor_index.begin(), sensor_index.end(), p);
+  } else {
+    std::fill_n(p, n, std::uint8_t{0});
+  }
 }
 
 void fill_trajectory(const pipeline::ActiveTrajectory& trajectory, trajroi::trajectory_t& out) {

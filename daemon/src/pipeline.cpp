@@ -17,7 +17,8 @@ Pipeline::Pipeline(const DaemonConfig& config_in, bool exact_in, bool recording)
           config_in.buffers.sweeps,
           [&config_in, exact_in] {
             pipeline::Sweep s;
-            s.reserve(config_in.buffers.max_points_per_sweep, 4096, pipeline::raw_points_capacity(config_in));
+            s.reserve(pipeline::sweep_points_capacity(config_in), 4096,
+                      pipeline::raw_points_capacity(config_in) * config_in.lidars.size());
             if (!exact_in) s.make_resident();
             return s;
           },

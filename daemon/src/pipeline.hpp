@@ -80,7 +80,9 @@ struct InputSlot {
   std::int64_t arrival_ns = 0;  // CLOCK_MONOTONIC when it entered the ring (latency)
   inputs::Stream stream = inputs::Stream::kLidarData;
   std::uint16_t size = 0;
-  bool decoded = false;  // a LiDAR data packet whose points wait in its lane's `decoded` ring
+  std::uint16_t port = 0;    // a datagram's destination port (several LiDARs tell theirs apart by it)
+  std::uint64_t sender = 0;  // … and by its sender (inputs::InputItem)
+  bool decoded = false;      // a LiDAR data packet whose points wait in its lane's `decoded` ring
   std::array<std::uint8_t, kMaxItemBytes> bytes{};
 };
 
@@ -164,10 +166,10 @@ struct Pipeline {
 
   const DaemonConfig& config;
   const bool exact;
-  // The processor's LiDAR stream (SweepProcessor::lidar_stream()), set before the threads
-  // start: the input threads decode LiDAR data packets ahead with its decoders
-  // (StreamDecoder::decoder_for), on their own core.
-  const vlp16::StreamDecoder* lidar_stream = nullptr;
+  // The processor (SweepProcessor), set before the threads start: the input threads route
+  // each LiDAR data packet to its sensor's lane (lane_for) and decode it ahead with that
+  // lane's decoders (StreamDecoder::decoder_for), on their own core. Const calls only.
+  const pipeline::SweepProcessor* processor = nullptr;
   std::atomic<bool> stop{false};
   std::atomic<std::uint64_t> sequence{0};
   EventFd process_wake, publish_wake, record_wake, main_wake;

@@ -68,7 +68,7 @@ class Processing {
   void handle(InputLane& lane, InputSlot& item) {
     const std::span<const std::uint8_t> bytes(item.bytes.data(), item.size);
     last_receive_ns_ = std::max(last_receive_ns_, item.receive_ns);
-    const inputs::InputItem input{item.stream, bytes, item.receive_ns};
+    const inputs::InputItem input{item.stream, bytes, item.receive_ns, item.sender, item.port};
     if (inputs::is_lidar(item.stream)) {
       const std::int64_t start = host::monotonic_ns();
       sink_.packet_started(start);

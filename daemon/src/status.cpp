@@ -59,6 +59,19 @@ void fill_snapshot(const pipeline::SweepProcessor& p, const Pipeline& pipeline, 
   s.position_packets = l.position_packets;
   s.lost_packets = l.lost_packets;
   s.decode_errors = l.rejected_total();
+  s.silent_lidars = 0;
+  for (std::size_t i = 1; i < p.lane_count(); ++i) {
+    const vlp16::StreamCounters& more = p.lidar_counters(i);
+    s.lidar_packets += more.data_packets;
+    s.position_packets += more.position_packets;
+    s.lost_packets += more.lost_packets;
+    s.decode_errors += more.rejected_total();
+  }
+  if (const pipeline::SweepMerger* merger = p.merger(); merger != nullptr) {
+    for (std::size_t i = 0; i < p.lane_count(); ++i) {
+      if (merger->silent(i, p.input_time_ns())) s.silent_lidars |= 1U << i;
+    }
+  }
   const pipeline::Sweep& current = p.current();
   constexpr std::int64_t kRecent_ns = 1'000'000'000;
   if (p.counters().sweeps > 0 && last_receive_ns - current.start_ns < kRecent_ns) {

@@ -104,6 +104,8 @@ struct StatusSnapshot {
   std::int32_t trajectory_id = 0;
   pipeline::ProcessorCounters processor;
   std::uint64_t lidar_packets = 0, position_packets = 0, lost_packets = 0, decode_errors = 0;
+  // Several LiDARs: bit i set while sensor i (lidars:) has given no sweep for lidar_merge.silent_s.
+  std::uint32_t silent_lidars = 0;
   // The pose at the newest sweep, or at the newest input when no sweep came in the last second
   // (so that the pose inputs' state shows without LiDAR data), with the failed gate's figures.
   bool pose_valid = false;

@@ -79,15 +79,30 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
                        config.realtime.lidar);
     return;
   }
-  vlp16::UdpOptions udp;
-  udp.bind_address = config.lidar.bind_address;
-  udp.data_port = config.lidar.data_port;
-  udp.position_port = config.lidar.position_port;
-  udp.receive_buffer_bytes = config.lidar.receive_buffer_bytes;
-  udp.sensor_address = config.lidar.sensor_address;
-  udp.share_ports = config.lidar.share_ports;
-  auto lidar = std::make_unique<inputs::UdpInput>(udp);
-  pipeline.add_input(std::move(lidar), config.buffers.lidar_packets, "trajroid-lidar", config.realtime.lidar);
+  // One pair of sockets per pair of ports: sensors sharing ports share the sockets (their
+  // packets told apart by sender in the processor), each only its sender when alone.
+  const std::vector<DaemonConfig::Lidar> lidars = config.all_lidars();
+  for (std::size_t i = 0; i < lidars.size(); ++i) {
+    const DaemonConfig::Lidar& l = lidars[i];
+    bool opened = false;
+    std::size_t sharing = 0;
+    for (std::size_t j = 0; j < lidars.size(); ++j) {
+      if (lidars[j].data_port != l.data_port) continue;
+      opened = opened || j < i;
+      ++sharing;
+    }
+    if (opened) continue;
+    vlp16::UdpOptions udp;
+    udp.bind_address = l.bind_address;
+    udp.data_port = l.data_port;
+    udp.position_port = l.position_port;
+    udp.receive_buffer_bytes = l.receive_buffer_bytes;
+    udp.sensor_address = sharing == 1 ? l.sensor_address : std::string();
+    udp.share_ports = l.share_ports;
+    auto lidar = std::make_unique<inputs::UdpInput>(udp);
+    const std::string thread = lidars.size() == 1 ? "trajroid-lidar" : ("trajroid-l-" + l.name).substr(0, 15);
+    pipeline.add_input(std::move(lidar), config.buffers.lidar_packets, thread, config.realtime.lidar);
+  }
   const auto add_serial = [&](const DaemonConfig::Serial& s, const char* name, inputs::Stream stream,
                               const ThreadConfig& thread) {
     if (s.device.empty()) {
@@ -179,7 +194,7 @@ int run_pipeline(Pipeline& pipeline, pipeline::SweepProcessor& processor, Outlet
                  bool signals) {
   const std::int64_t start_ns = host::monotonic_ns();
   const int sfd = signals ? block_signals() : -1;
-  pipeline.lidar_stream = &processor.lidar_stream();  // the input threads decode ahead with its decoders
+  pipeline.processor = &processor;  // the input threads route and decode ahead with its lanes' decoders
   Reloader reloader(TrajectorySource::from(pipeline.config), pipeline.publish_wake);
   Publisher publisher(pipeline, outlet, &reloader, options.replay.has_value(), processor.active_trajectory());
   ProcessingOptions processing;

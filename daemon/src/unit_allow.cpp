@@ -116,10 +116,18 @@ UnitAllowLists unit_allow_lists(const DaemonConfig& config, const std::string& l
                               ": the source of LCM multicast from local peers and of the daemon's own");
     }
   }
-  if (!config.lidar.sensor_address.empty()) {
-    add_unique(lists.ip_allow, config.lidar.sensor_address);
-    lists.reasons.push_back("the LiDAR at " + config.lidar.sensor_address + " (lidar.sensor_address)");
-  } else {
+  bool any_sender = false;
+  for (const DaemonConfig::Lidar& l : config.all_lidars()) {
+    if (l.sensor_address.empty()) {
+      any_sender = true;
+      continue;
+    }
+    add_unique(lists.ip_allow, l.sensor_address);
+    lists.reasons.push_back(config.lidars.size() == 1
+                                ? "the LiDAR at " + l.sensor_address + " (lidar.sensor_address)"
+                                : "the LiDAR " + l.name + " at " + l.sensor_address + " (lidars: sensor_address)");
+  }
+  if (any_sender) {
     // Any sender is accepted: the ranges a sensor on a robot's network has (RFC 1918, link-local).
     for (const char* range : {"10.0.0.0/8", "172.16.0.0/12", "192.168.0.0/16", "169.254.0.0/16"})
       add_unique(lists.ip_allow, range);

@@ -75,11 +75,13 @@ void Sweep::take(Sweep& other) {
   static_cast<SweepHeader&>(*this) = other;
   PointColumns::swap(other);
   raw.swap(other.raw);
+  sensor_index.swap(other.sensor_index);
   point_index = other.point_index;  // kept for evaluations only: unreserved in the ring's slots
 }
 
 void Sweep::reserve(std::size_t points, std::size_t centre_count, std::size_t raw_points) {
   PointColumns::reserve(points);
+  sensor_index.reserve(points);
   raw.reserve(raw_points);
   centres.reserve(centre_count);
 }
@@ -87,12 +89,14 @@ void Sweep::reserve(std::size_t points, std::size_t centre_count, std::size_t ra
 void Sweep::make_resident() {
   clear_points();
   PointColumns::make_resident();
+  touch_capacity(sensor_index);
   raw.make_resident();
 }
 
 void Sweep::clear_points() noexcept {
   PointColumns::clear();
   raw.clear();
+  sensor_index.clear();
   point_index.clear();
 }
 

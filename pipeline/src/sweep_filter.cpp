@@ -9,54 +9,55 @@
 
 namespace trajroi::pipeline {
 
-void SweepProcessor::add_points(const vlp16::Frame& frame, std::size_t first, SweepSink& sink) {
-  if (first == 0 || !in_sweep_) {
-    start_sweep(frame);
-    unfiltered_from_ = first;
+void SweepProcessor::add_points(Lane& lane, const vlp16::Frame& frame, std::size_t first, SweepSink& sink) {
+  if (first == 0 || !lane.in_sweep) {
+    start_sweep(lane, frame);
+    lane.unfiltered_from = first;
   }
-  sweep_.last_packet_arrival_ns = arrival_ns_;
+  lane.sweep.last_packet_arrival_ns = arrival_ns_;
   // The points wait until a whole batch has come (a few packets, a millisecond or two of the
   // sensor's): the scan and the placing are set up once per batch, not per packet (as-fast
   // replay of the dual-return corridor: processing thread 12 % less). Their firings' poses
   // are taken then, from the GNSS and IMU samples received until then, in the order of
   // arrival as before (one that came meanwhile interpolates where it was extrapolated). The
   // sweep's end filters the rest.
-  filter_points(frame, kScratchPoints, sink);
+  filter_points(lane, frame, kScratchPoints, sink);
 }
 
-void SweepProcessor::filter_points(const vlp16::Frame& frame, std::size_t at_least, SweepSink& sink) {
+void SweepProcessor::filter_points(Lane& lane, const vlp16::Frame& frame, std::size_t at_least, SweepSink& sink) {
   const std::size_t end = frame.points.size();
-  for (; unfiltered_from_ < end && end - unfiltered_from_ >= at_least && sweep_.filtered;
-       unfiltered_from_ = std::min(end, unfiltered_from_ + kScratchPoints)) {
-    const std::size_t i = unfiltered_from_;
-    const pose::PoseStatus status = filter_batch(frame, i, std::min(end, i + kScratchPoints), sink);
+  Sweep& s = lane.sweep;
+  for (; lane.unfiltered_from < end && end - lane.unfiltered_from >= at_least && s.filtered;
+       lane.unfiltered_from = std::min(end, lane.unfiltered_from + kScratchPoints)) {
+    const std::size_t i = lane.unfiltered_from;
+    const pose::PoseStatus status = filter_batch(lane, frame, i, std::min(end, i + kScratchPoints), sink);
     if (status != pose::PoseStatus::kValid) {
-      sweep_.filtered = false;
-      sweep_.pose_status = status;
-      sweep_.pose_measured = firing_.measured();
-      sweep_.pose_limit = firing_.limit();
-      sweep_.clear_points();
+      s.filtered = false;
+      s.pose_status = status;
+      s.pose_measured = lane.firing.measured();
+      s.pose_limit = lane.firing.limit();
+      s.clear_points();
       have_hint_ = false;
     }
   }
 }
 
-pose::PoseStatus SweepProcessor::filter_batch(const vlp16::Frame& frame, std::size_t first, std::size_t end,
+pose::PoseStatus SweepProcessor::filter_batch(Lane& lane, const vlp16::Frame& frame, std::size_t first, std::size_t end,
                                               SweepSink& sink) {
   const auto place_run = [&](std::size_t from, std::size_t to, const Eigen::Isometry3d& global_from_lidar) {
     roi::transform_records(global_from_lidar, std::span(frame.points).subspan(from, to - from),
                            scratch_.data() + (from - first));
   };
   if (config_.pose_mode == PoseMode::kPerSweep) {
-    place_run(first, end, sweep_sensor_pose_);
+    place_run(first, end, lane.sweep_sensor_pose);
   } else {
     // Per firing: the points of one firing period (in time order) share a pose.
     for (std::size_t i = first; i < end;) {
       pose::PoseStatus status{};
-      const Eigen::Isometry3d* pose = firing_.at(frame.start_time_ns + frame.points[i].time_offset_ns, status);
+      const Eigen::Isometry3d* pose = lane.firing.at(frame.start_time_ns + frame.points[i].time_offset_ns, status);
       if (pose == nullptr) return status;
       // The following points the same pose covers, in the frame's time offsets.
-      const pose::FiringPoses::Window window = firing_.window_after(frame.start_time_ns);
+      const pose::FiringPoses::Window window = lane.firing.window_after(frame.start_time_ns);
       std::size_t j = i + 1;
       while (j < end && window.contains(frame.points[j].time_offset_ns))
         ++j;
@@ -66,9 +67,9 @@ pose::PoseStatus SweepProcessor::filter_batch(const vlp16::Frame& frame, std::si
   }
   const std::span<const roi::PointXYZI> placed(scratch_.data(), end - first);
   sink.on_placed(frame, first, placed);
-  if (config_.outputs.raw_points) keep_raw(frame, first, end);
-  (void)chain_.filter(placed, kept_);
-  Sweep& s = sweep_;
+  if (config_.outputs.raw_points) keep_raw(lane, frame, first, end);
+  (void)lane.chain.filter(placed, kept_);
+  Sweep& s = lane.sweep;
   const std::size_t room =
       config_.buffers.max_points_per_sweep - std::min(config_.buffers.max_points_per_sweep, s.size());
   const std::size_t n = std::min(room, kept_.size());
@@ -115,9 +116,9 @@ std::size_t raw_points_capacity(const DaemonConfig& config) noexcept {
   return config.outputs.raw_points ? config.buffers.max_points_per_sweep / config.outputs.raw_points_decimation : 0;
 }
 
-void SweepProcessor::keep_raw(const vlp16::Frame& frame, std::size_t first, std::size_t end) {
+void SweepProcessor::keep_raw(Lane& lane, const vlp16::Frame& frame, std::size_t first, std::size_t end) {
   const std::size_t every = config_.outputs.raw_points_decimation;
-  PointColumns& raw = sweep_.raw;
+  PointColumns& raw = lane.sweep.raw;
   const std::size_t capacity = raw.x.capacity();
   for (std::size_t i = (first + every - 1) / every * every; i < end && raw.size() < capacity; i += every) {
     const roi::PointXYZI& g = scratch_[i - first];
@@ -132,14 +133,14 @@ void SweepProcessor::keep_raw(const vlp16::Frame& frame, std::size_t first, std:
   }
 }
 
-void SweepProcessor::end_sweep(const vlp16::Frame& frame, SweepSink& sink) {
-  if (!in_sweep_) {
-    start_sweep(frame);  // a frame of packets without points
-    unfiltered_from_ = frame.points.size();
+void SweepProcessor::end_sweep(Lane& lane, const vlp16::Frame& frame, SweepSink& sink) {
+  if (!lane.in_sweep) {
+    start_sweep(lane, frame);  // a frame of packets without points
+    lane.unfiltered_from = frame.points.size();
   }
-  filter_points(frame, 1, sink);
-  in_sweep_ = false;
-  Sweep& s = sweep_;
+  filter_points(lane, frame, 1, sink);
+  lane.in_sweep = false;
+  Sweep& s = lane.sweep;
   s.index = frame.index;
   s.end_ns = frame.end_time_ns;
   s.partial = frame.partial;
@@ -156,7 +157,11 @@ void SweepProcessor::end_sweep(const vlp16::Frame& frame, SweepSink& sink) {
     ++counters_.sweeps_without_pose;
     s.clear_points();
   }
-  sink.on_sweep(s);
+  if (merger_) {
+    merger_->add(lane.index, s, now_ns_, sink);
+  } else {
+    sink.on_sweep(s);
+  }
 }
 
 }  // namespace trajroi::pipeline

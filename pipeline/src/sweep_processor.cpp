@@ -1,7 +1,10 @@
 #include "trajroi/pipeline/sweep_processor.hpp"
 
+#include <arpa/inet.h>
+
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
@@ -30,9 +33,9 @@ double size_along(const DaemonConfig::Roi& r) {
 
 }  // namespace
 
-vlp16::Calibration load_calibration(const DaemonConfig& c) {
-  const std::filesystem::path& file = c.lidar.calibration;
-  const std::optional<vlp16::Model> model = vlp16::model_named(c.lidar.model);
+vlp16::Calibration load_calibration(const DaemonConfig::Lidar& lidar) {
+  const std::filesystem::path& file = lidar.calibration;
+  const std::optional<vlp16::Model> model = vlp16::model_named(lidar.model);
   if (file.empty()) return vlp16::Calibration::for_model(model.value_or(vlp16::Model::kVlp16));
   vlp16::Calibration calibration = vlp16::parse_calibration_file(config::read_text_file(file), file.string());
   const vlp16::ModelSpec& s = vlp16::spec(model.value_or(vlp16::Model::kVlp16));
@@ -42,21 +45,21 @@ vlp16::Calibration load_calibration(const DaemonConfig& c) {
   }
   if (calibration.laser_count != s.lasers) {
     throw config::ConfigError("lidar.calibration " + file.string() + ": " + std::to_string(calibration.laser_count) +
-                              " lasers, but a " + std::string(s.name) + " (lidar.model " + c.lidar.model + ") has " +
+                              " lasers, but a " + std::string(s.name) + " (lidar.model " + lidar.model + ") has " +
                               std::to_string(s.lasers));
   }
   return calibration;
 }
 
-vlp16::StreamOptions stream_options(const DaemonConfig& c) {
+vlp16::StreamOptions stream_options(const DaemonConfig::Lidar& lidar) {
   vlp16::StreamOptions o;
   // A model named, or told from the packets; a calibration file without a model is a VLP-16's.
-  const std::optional<vlp16::Model> model = vlp16::model_named(c.lidar.model);
+  const std::optional<vlp16::Model> model = vlp16::model_named(lidar.model);
   o.model = model.value_or(vlp16::Model::kVlp16);
-  o.detect_model = !model && c.lidar.calibration.empty();
-  o.decode.min_range_m = c.lidar.min_range_m;
-  o.decode.max_range_m = c.lidar.max_range_m;
-  o.cut_azimuth_deg = c.lidar.cut_azimuth_deg;
+  o.detect_model = !model && lidar.calibration.empty();
+  o.decode.min_range_m = lidar.min_range_m;
+  o.decode.max_range_m = lidar.max_range_m;
+  o.cut_azimuth_deg = lidar.cut_azimuth_deg;
   return o;
 }
 
@@ -77,55 +80,118 @@ pose_input::PoseInputConfig pose_input_config(const DaemonConfig& c) {
 // Routes the stream decoder's callbacks to the processor and on to the caller's sink.
 class SweepProcessor::FrameAdapter final : public vlp16::FrameSink {
  public:
-  FrameAdapter(SweepProcessor& processor, SweepSink& sink) : processor_(processor), sink_(sink) {}
-  void on_points(const vlp16::Frame& frame, std::size_t first) override { processor_.add_points(frame, first, sink_); }
-  void on_frame(const vlp16::Frame& frame) override { processor_.end_sweep(frame, sink_); }
+  FrameAdapter(SweepProcessor& processor, Lane& lane, SweepSink& sink)
+      : processor_(processor), lane_(lane), sink_(sink) {}
+  void on_points(const vlp16::Frame& frame, std::size_t first) override {
+    processor_.add_points(lane_, frame, first, sink_);
+  }
+  void on_frame(const vlp16::Frame& frame) override { processor_.end_sweep(lane_, frame, sink_); }
 
  private:
   SweepProcessor& processor_;
+  Lane& lane_;
   SweepSink& sink_;
 };
 
+namespace {
+
+std::size_t chain_capacity(const DaemonConfig::Roi& r) {
+  const double longest = r.look_ahead_m + r.max_speed_mps * r.look_ahead_per_mps_s;
+  return static_cast<std::size_t>(longest / (r.spacing_ratio * size_along(r))) + 2;
+}
+
+std::uint32_t address_of(const std::string& text) {
+  in_addr a{};
+  return !text.empty() && inet_pton(AF_INET, text.c_str(), &a) == 1 ? ntohl(a.s_addr) : 0;
+}
+
+}  // namespace
+
+SweepProcessor::Lane::Lane(const DaemonConfig& config, const DaemonConfig::Lidar& l, const pose::PoseBuffer& poses)
+    : lidar(l),
+      decoder(load_calibration(l), stream_options(l)),
+      firing(
+          poses, l.robot_from_lidar,
+          config.pose_mode == PoseMode::kPerSweep ? std::numeric_limits<std::int64_t>::max() : vlp16::kFiringCycle_ns),
+      chain(config.roi.shape,
+            roi::ChainSize{config.roi.circle_diameter_m / 2.0, config.roi.rect_height_m, config.roi.rect_width_m},
+            roi::ZLimits{config.roi.z_min_m, config.roi.z_max_m}),
+      sender(address_of(l.sensor_address)) {}
+
 SweepProcessor::SweepProcessor(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> trajectory)
     : config_(config),
-      decoder_(load_calibration(config), stream_options(config)),
       // A localization's pose is the robot origin's own: no lever arm.
       poses_(config.gate, config.pose_source == PoseSource::kLcm ? Eigen::Vector3d::Zero() : config.gnss_antenna_m,
              config.pose_capacity),
       pose_input_(pose::GlobalFrame::local_cartesian(config.origin), pose_input_config(config), poses_),
-      firing_(
-          poses_, config.lidar.robot_from_lidar,
-          config.pose_mode == PoseMode::kPerSweep ? std::numeric_limits<std::int64_t>::max() : vlp16::kFiringCycle_ns),
-      active_(std::move(trajectory)),
-      chain_(config.roi.shape,
-             roi::ChainSize{config.roi.circle_diameter_m / 2.0, config.roi.rect_height_m, config.roi.rect_width_m},
-             roi::ZLimits{config.roi.z_min_m, config.roi.z_max_m}) {
+      active_(std::move(trajectory)) {
   if (!active_) throw std::invalid_argument("SweepProcessor: no trajectory");
   if (config_.pose_source == PoseSource::kFixed) poses_.hold(config_.fixed_pose);
   // Preallocate and touch: the largest chain the look-ahead can need, its grid, the sweep.
   const DaemonConfig::Roi& r = config_.roi;
   const double longest = r.look_ahead_m + r.max_speed_mps * r.look_ahead_per_mps_s;
-  const auto centres = static_cast<std::size_t>(longest / (r.spacing_ratio * size_along(r))) + 2;
-  sweep_.reserve(config_.buffers.max_points_per_sweep, centres, raw_points_capacity(config_));
-  chain_.reserve(centres);
+  const std::size_t centres = chain_capacity(r);
+  for (const DaemonConfig::Lidar& lidar : config_.all_lidars()) {
+    auto lane = std::make_unique<Lane>(config_, lidar, poses_);
+    lane->index = lanes_.size();
+    lane->sweep.reserve(config_.buffers.max_points_per_sweep, centres, raw_points_capacity(config_));
+    lane->chain.reserve(centres);
+    lane->chain.place(active_->trajectory, 0.0, longest, r.spacing_ratio * size_along(r),
+                      roi::ChainSize{r.circle_diameter_m / 2.0, r.rect_height_m, r.rect_width_m});
+    lanes_.push_back(std::move(lane));
+  }
+  if (lanes_.size() > 1) {
+    MergeOptions m;
+    m.max_wait_ns = std::llround(config_.lidar_merge.max_wait_s * 1e9);
+    m.silent_ns = std::llround(config_.lidar_merge.silent_s * 1e9);
+    m.per_sensor = config_.lidar_merge.per_sensor;
+    merger_ = std::make_unique<SweepMerger>(lanes_.size(), config_.buffers.max_points_per_sweep, centres,
+                                            raw_points_capacity(config_), m);
+  }
   scratch_.resize(kScratchPoints);  // used as [0, batch): never resized (value-initialising) after
   kept_.reserve(kScratchPoints);
-  chain_.place(active_->trajectory, 0.0, longest, r.spacing_ratio * size_along(r),
-               roi::ChainSize{r.circle_diameter_m / 2.0, r.rect_height_m, r.rect_width_m});
 }
 
 SweepProcessor::~SweepProcessor() = default;
 
+void SweepProcessor::make_resident() {
+  for (const auto& lane : lanes_)
+    lane->sweep.make_resident();
+  if (merger_) merger_->make_resident();
+}
+
+int SweepProcessor::lane_for(const inputs::InputItem& item) const noexcept {
+  if (lanes_.size() == 1) return 0;  // one LiDAR: its sockets take only its sender
+  const auto address = static_cast<std::uint32_t>(item.sender >> 16);
+  for (std::size_t i = 0; i < lanes_.size(); ++i) {
+    const DaemonConfig::Lidar& l = lanes_[i]->lidar;
+    const bool port =
+        item.port == 0 || item.port == (item.stream == inputs::Stream::kLidarData ? l.data_port : l.position_port);
+    if (port && (lanes_[i]->sender == 0 || lanes_[i]->sender == address)) return static_cast<int>(i);
+  }
+  return -1;
+}
+
 void SweepProcessor::process(const inputs::InputItem& item, SweepSink& sink, const vlp16::DecodedPacket* decoded) {
+  now_ns_ = item.receive_ns;
+  if (merger_) merger_->tick(item.receive_ns, sink);
   switch (item.stream) {
-    case inputs::Stream::kLidarData: {
-      FrameAdapter adapter(*this, sink);
-      decoder_.on_data_packet(item.bytes, item.receive_ns, adapter, decoded);
+    case inputs::Stream::kLidarData:
+    case inputs::Stream::kLidarPosition: {
+      const int index = lane_for(item);
+      if (index < 0) {
+        ++counters_.lidar_unknown_sender;
+        break;
+      }
+      Lane& lane = *lanes_[static_cast<std::size_t>(index)];
+      if (item.stream == inputs::Stream::kLidarPosition) {
+        lane.decoder.on_position_packet(item.bytes);
+        break;
+      }
+      FrameAdapter adapter(*this, lane, sink);
+      lane.decoder.on_data_packet(item.bytes, item.receive_ns, adapter, decoded);
       break;
     }
-    case inputs::Stream::kLidarPosition:
-      decoder_.on_position_packet(item.bytes);
-      break;
     case inputs::Stream::kGnss:
       pose_input_.gnss_bytes(item.bytes, item.receive_ns);
       break;
@@ -178,13 +244,17 @@ void SweepProcessor::pose_message(std::span<const std::uint8_t> bytes) {
 }
 
 void SweepProcessor::flush(SweepSink& sink) {
-  FrameAdapter adapter(*this, sink);
-  decoder_.flush(adapter);
+  for (const auto& lane : lanes_) {
+    FrameAdapter adapter(*this, *lane, sink);
+    lane->decoder.flush(adapter);
+  }
+  if (merger_) merger_->flush(sink);
 }
 
 void SweepProcessor::keep_point_indices() {
   keep_indices_ = true;
-  sweep_.point_index.reserve(config_.buffers.max_points_per_sweep);
+  for (const auto& lane : lanes_)
+    lane->sweep.point_index.reserve(config_.buffers.max_points_per_sweep);
 }
 
 void SweepProcessor::offer_trajectory(std::unique_ptr<ActiveTrajectory> trajectory) {
@@ -196,15 +266,15 @@ std::unique_ptr<ActiveTrajectory> SweepProcessor::take_retired() noexcept {
   return std::move(retired_);
 }
 
-void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
-  in_sweep_ = true;
+void SweepProcessor::start_sweep(Lane& lane, const vlp16::Frame& frame) {
+  lane.in_sweep = true;
   if (pending_) {
     retired_ = std::move(active_);
     active_ = std::move(pending_);
     have_hint_ = false;
     ++counters_.trajectory_swaps;
   }
-  Sweep& s = sweep_;
+  Sweep& s = lane.sweep;
   s.clear_points();
   s.centres.clear();
   s.truncated = 0;
@@ -213,7 +283,7 @@ void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
     s.start_utc_ns = *frame.start_utc_ns;
     s.time_source = "vlp16_pps";
     if (host_utc_offset_ns_) {
-      host_minus_lidar_utc_s_ =
+      lane.host_minus_lidar_utc_s =
           static_cast<double>(frame.start_time_ns + *host_utc_offset_ns_ - *frame.start_utc_ns) * 1e-9;
     }
   } else if (host_utc_offset_ns_) {
@@ -230,7 +300,7 @@ void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
   const pose::GnssFix* fix = poses_.newest_fix();
   s.fix = fix != nullptr ? fix->quality : pose::FixQuality{};
   s.fix_t_ns = fix != nullptr ? fix->t_ns : 0;
-  firing_.reset();
+  lane.firing.reset();
 
   const pose::PoseQuery q = poses_.pose_at(frame.start_time_ns);
   s.pose_status = q.status;
@@ -245,8 +315,8 @@ void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
     return;
   }
   s.robot = PublishedPose::from(q.global_from_robot);
-  s.sensor = PublishedPose::from(s.robot.isometry() * config_.lidar.robot_from_lidar);
-  sweep_sensor_pose_ = s.sensor.isometry();
+  s.sensor = PublishedPose::from(s.robot.isometry() * lane.lidar.robot_from_lidar);
+  lane.sweep_sensor_pose = s.sensor.isometry();
   const Eigen::Vector2d position = q.global_from_robot.translation().head<2>();
   s.speed_known = false;
   if (!valid_since_ns_) valid_since_ns_ = frame.start_time_ns;
@@ -260,12 +330,12 @@ void SweepProcessor::start_sweep(const vlp16::Frame& frame) {
       break;
     }
   }
-  place_chain(position);
+  place_chain(lane, position);
 }
 
-void SweepProcessor::place_chain(const Eigen::Vector2d& position) {
+void SweepProcessor::place_chain(Lane& lane, const Eigen::Vector2d& position) {
   const DaemonConfig::Roi& r = config_.roi;
-  Sweep& s = sweep_;
+  Sweep& s = lane.sweep;
   const roi::Trajectory& trajectory = active_->trajectory;
   roi::Projection p =
       have_hint_ ? trajectory.project(position, s_hint_m_, kMaxAdvancePerSweep_m) : trajectory.project(position);
@@ -295,8 +365,9 @@ void SweepProcessor::place_chain(const Eigen::Vector2d& position) {
     s.width_m = r.rect_width_m + grow;
     s.spacing_m = roi::spacing_from_ratio(r.spacing_ratio, r.rect_height_m);
   }
-  chain_.place(trajectory, s.start_s_m, s.look_ahead_m, s.spacing_m, roi::ChainSize{s.radius_m, s.height_m, s.width_m});
-  s.centres.assign(chain_.centres().begin(), chain_.centres().end());
+  lane.chain.place(trajectory, s.start_s_m, s.look_ahead_m, s.spacing_m,
+                   roi::ChainSize{s.radius_m, s.height_m, s.width_m});
+  s.centres.assign(lane.chain.centres().begin(), lane.chain.centres().end());
 }
 
 }  // namespace trajroi::pipeline

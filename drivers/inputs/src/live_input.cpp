@@ -54,6 +54,7 @@ UdpInput::Next UdpInput::next(InputItem& item, std::chrono::milliseconds timeout
   item.stream = d.destination_port == udp_->position_port() ? Stream::kLidarPosition : Stream::kLidarData;
   item.bytes = d.payload;
   item.sender = d.sender;
+  item.port = d.destination_port;
   ++items_;
   return Next::kItem;
 }

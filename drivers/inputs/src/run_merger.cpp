@@ -70,6 +70,7 @@ void RunMerger::fill_lidar() {
     if (lidar_start_ns_ && !lidar_shift_ns_) lidar_shift_ns_ = *lidar_start_ns_ - d.receive_time_ns;
     lidar_.t = d.receive_time_ns + lidar_shift_ns_.value_or(0) + shift_ns_;
     lidar_.stream = d.destination_port == vlp16::kPositionPort ? Stream::kLidarPosition : Stream::kLidarData;
+    lidar_.sender = d.sender;
     lidar_.bytes.assign(d.payload.begin(), d.payload.end());
     return;
   }
@@ -105,6 +106,7 @@ bool RunMerger::next(InputItem& item) {
   if (p == nullptr) return false;
   out_.swap(p->bytes);
   item.stream = p->stream;
+  item.sender = p->sender;
   item.receive_ns = p->t;
   item.bytes = out_;
   first_ns_ = std::min(first_ns_, p->t);

@@ -364,6 +364,9 @@ PcapSource::Next PcapSource::read(Datagram& datagram) {
     }
     datagram.payload = std::span<const std::uint8_t>(frame + udp + 8, udp_length - 8);
     datagram.destination_port = port;
+    // The IPv4 source address and UDP source port, as a live socket reports them.
+    datagram.sender = (static_cast<std::uint64_t>(be16(frame + at + 12)) << 32) |
+                      (static_cast<std::uint64_t>(be16(frame + at + 14)) << 16) | be16(frame + udp);
     datagram.receive_time_ns = time_ns;
     return Next::kDatagram;
   }

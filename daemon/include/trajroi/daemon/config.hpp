@@ -42,6 +42,9 @@ struct ThreadConfig {
   std::vector<int> cpus;  // affinity; empty: any
 };
 
+// The most LiDARs one trajroid takes (`lidars:`).
+inline constexpr std::size_t kMaxLidars = 8;
+
 struct DaemonConfig {
   std::filesystem::path file;  // where it was read from
 
@@ -50,7 +53,10 @@ struct DaemonConfig {
   std::filesystem::path trajectory_file;  // CSV of x,y (global frame, m) or lat,lon (degrees)
   TrajectoryCoordinates trajectory_coordinates = TrajectoryCoordinates::kGlobalXy;  // without a header line
 
+  // One LiDAR (`lidar:`), or each of several (`lidars:`, a list with names). `lidar` is always
+  // the first of `lidars` (which holds at least one).
   struct Lidar {
+    std::string name = "lidar";  // `lidars:` entries: required, unique (logs, status, the view)
     // auto (told from the packets' product id), vlp16, puck_lite, puck_hires, vlp32c, hdl32e.
     std::string model = "auto";
     std::filesystem::path calibration;  // velodyne/nebula YAML; empty: the manual's values
@@ -65,6 +71,17 @@ struct DaemonConfig {
     int receive_buffer_bytes = 4 << 20;
     bool share_ports = false;  // SO_REUSEADDR: other readers may bind the same ports (multicast)
   } lidar;
+  std::vector<Lidar> lidars{Lidar{}};
+  // The LiDARs to run: `lidars` when several, else the one `lidar` holds (read from lidar:, or
+  // set in code).
+  [[nodiscard]] std::vector<Lidar> all_lidars() const { return lidars.size() > 1 ? lidars : std::vector<Lidar>{lidar}; }
+  // Several LiDARs: their sweeps merged into one points_t per time window (a sensor index per
+  // point), or published one by one.
+  struct LidarMerge {
+    double max_wait_s = 0.1;  // after a window's first sweep, at most this for the others
+    double silent_s = 0.5;    // a sensor without a sweep this long is not waited for (and named)
+    bool per_sensor = false;  // true: each sensor's sweep published alone (sensor index set)
+  } lidar_merge;
 
   struct Serial {
     std::string device;  // empty: this stream is not used live

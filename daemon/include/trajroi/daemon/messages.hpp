@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -30,14 +31,16 @@ void fill_points(const pipeline::Sweep& sweep, const DaemonConfig& config, trajr
 void encode_points(const pipeline::Sweep& sweep, const DaemonConfig& config, trajroi::points_t& head,
                    std::vector<std::uint8_t>& out);
 // The same with other columns under the sweep's head: the decoded points before the ROI
-// (outputs.raw_points, Sweep::raw).
-void encode_points(const pipeline::SweepHeader& sweep, const pipeline::PointColumns& points, const DaemonConfig& config,
-                   trajroi::points_t& head, std::vector<std::uint8_t>& out);
+// (outputs.raw_points, Sweep::raw; `sensor_index` empty: all the one LiDAR's, or not told
+// for several).
+void encode_points(const pipeline::SweepHeader& sweep, const pipeline::PointColumns& points,
+                   std::span<const std::uint8_t> sensor_index, const DaemonConfig& config, trajroi::points_t& head,
+                   std::vector<std::uint8_t>& out);
 // The active trajectory as published on lcm.channels.active_trajectory: its id, GLOBAL_XY.
 void fill_trajectory(const pipeline::ActiveTrajectory& trajectory, trajroi::trajectory_t& out);
 // The bytes a point takes in that encoding: x, y, z, time offset and one each of intensity,
-// ring and return type.
-inline constexpr std::size_t kEncodedBytesPerPoint = 4 * sizeof(std::uint32_t) + 3;
+// ring, return type and sensor.
+inline constexpr std::size_t kEncodedBytesPerPoint = 4 * sizeof(std::uint32_t) + 4;
 void fill_roi(const pipeline::Sweep& sweep, trajroi::roi_t& out);
 
 // Why an incoming trajectory was refused (counted by reason in status_t).

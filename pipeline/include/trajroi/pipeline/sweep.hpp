@@ -68,6 +68,11 @@ struct SweepHeader {
   pose::FixQuality fix;        // newest fix at the sweep's start
   std::int64_t fix_t_ns = 0;   // its time (0: none)
 
+  // Several LiDARs (lidars:): bit i set when sensor i's points are in this sweep (0: the one
+  // LiDAR of lidar:); `missing` those the merge waited for and did not get.
+  std::uint32_t sensors = 0;
+  std::uint32_t missing = 0;
+
   // The ROI chain.
   std::int32_t trajectory_id = 0;
   RoiShape shape = RoiShape::kCircular;
@@ -109,6 +114,8 @@ struct Sweep : SweepHeader, PointColumns {
   // point's index among the decoded sweep's points (vlp16::Frame::points), for scoring against
   // per-point truth.
   Array<std::uint32_t> point_index;
+  // Several LiDARs: the sensor (its index in lidars:) of each kept point; empty for one LiDAR.
+  Array<std::uint8_t> sensor_index;
   // With outputs.raw_points: every decoded point of the sweep placed in the global frame,
   // before the ROI, one in outputs.raw_points_decimation (by its index in the sweep); empty
   // otherwise, and for a sweep without a valid pose.

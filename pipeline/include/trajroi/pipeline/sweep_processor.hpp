@@ -28,6 +28,7 @@
 #include "trajroi/daemon/config.hpp"
 #include "trajroi/inputs/input_source.hpp"
 #include "trajroi/pipeline/sweep.hpp"
+#include "trajroi/pipeline/sweep_merger.hpp"
 #include "trajroi/pose/pose_buffer.hpp"
 #include "trajroi/pose_input/pose_input.hpp"
 #include "trajroi/roi/roi_chain.hpp"
@@ -49,17 +50,29 @@ struct ProcessorCounters {
   std::uint64_t trajectory_swaps = 0;
   std::uint64_t projection_reacquired = 0;    // the robot far from where progress along the trajectory put it
   std::uint64_t pose_messages_malformed = 0;  // pose_input_t that did not decode, or unknown clock / frame
+  std::uint64_t lidar_unknown_sender = 0;     // several LiDARs: a datagram from no configured sensor's address
 };
 
 // The configured calibration (lidar.calibration; the manual's values when none) and decoding
 // options (ranges, the sweep's cut azimuth): what the processor decodes with. Throws
 // config::ConfigError for a calibration file that cannot be read or parsed.
-[[nodiscard]] vlp16::Calibration load_calibration(const DaemonConfig& config);
-[[nodiscard]] vlp16::StreamOptions stream_options(const DaemonConfig& config);
+[[nodiscard]] vlp16::Calibration load_calibration(const DaemonConfig::Lidar& lidar);
+[[nodiscard]] vlp16::StreamOptions stream_options(const DaemonConfig::Lidar& lidar);
+[[nodiscard]] inline vlp16::Calibration load_calibration(const DaemonConfig& config) {
+  return load_calibration(config.lidar);
+}
+[[nodiscard]] inline vlp16::StreamOptions stream_options(const DaemonConfig& config) {
+  return stream_options(config.lidar);
+}
 
 // The decoded points a sweep holds for outputs.raw_points: buffers.max_points_per_sweep /
 // outputs.raw_points_decimation (0 when off); more are left out.
 [[nodiscard]] std::size_t raw_points_capacity(const DaemonConfig& config) noexcept;
+// The kept points a sweep handed on holds at most: buffers.max_points_per_sweep, for each
+// LiDAR when several are merged.
+[[nodiscard]] inline std::size_t sweep_points_capacity(const DaemonConfig& config) noexcept {
+  return config.buffers.max_points_per_sweep * (config.lidar_merge.per_sensor ? 1 : config.lidars.size());
+}
 
 // How the configuration sets up the pose input (IMU mounting and declination, the delays).
 [[nodiscard]] pose_input::PoseInputConfig pose_input_config(const DaemonConfig& config);
@@ -72,10 +85,10 @@ class SweepProcessor {
   // Times the ROI filter's scans for the configured shape on its start-up grid and makes
   // the fastest on this machine the one used (roi::RoiChain::calibrate); at start, before
   // the first sweep.
-  roi::ScanCalibration calibrate_scan() const { return chain_.calibrate(); }
+  roi::ScanCalibration calibrate_scan() const { return lanes_[0]->chain.calibrate(); }
   // Makes the sweep it fills resident (Sweep::make_resident); at start, before the first
   // datagram.
-  void make_resident() { sweep_.make_resident(); }
+  void make_resident();
 
   // The one entry: an input item of any stream, in the inputs' global order. LiDAR data
   // packets are decoded and their points placed and filtered, sweeps going to `sink` as they
@@ -86,8 +99,20 @@ class SweepProcessor {
   void process(const inputs::InputItem& item, SweepSink& sink, const vlp16::DecodedPacket* decoded = nullptr);
   // The packet decoder the stream decodes with: const and stateless, for another thread to
   // decode packets ahead.
-  [[nodiscard]] const vlp16::PacketDecoder& packet_decoder() const noexcept { return decoder_.decoder(); }
-  [[nodiscard]] const vlp16::StreamDecoder& lidar_stream() const noexcept { return decoder_; }
+  [[nodiscard]] const vlp16::PacketDecoder& packet_decoder() const noexcept { return lanes_[0]->decoder.decoder(); }
+  [[nodiscard]] const vlp16::StreamDecoder& lidar_stream(std::size_t lane = 0) const noexcept {
+    return lanes_[lane]->decoder;
+  }
+  // Several LiDARs (lidars:): one lane each, in the configuration's order. The lane a LiDAR
+  // datagram is for, by its destination port and sender (-1: no configured sensor's). Const:
+  // the input threads route with it to decode ahead.
+  [[nodiscard]] std::size_t lane_count() const noexcept { return lanes_.size(); }
+  [[nodiscard]] int lane_for(const inputs::InputItem& item) const noexcept;
+  [[nodiscard]] const DaemonConfig::Lidar& lane_lidar(std::size_t lane) const noexcept { return lanes_[lane]->lidar; }
+  // The merge of several LiDARs' sweeps (null with one LiDAR).
+  [[nodiscard]] const SweepMerger* merger() const noexcept { return merger_.get(); }
+  // The input time of the newest item processed.
+  [[nodiscard]] std::int64_t input_time_ns() const noexcept { return now_ns_; }
   // Steady-clock time the next datagram entered the daemon: a sweep keeps that of the last
   // datagram that gave it points (for the latency figures; no effect on the output).
   void set_input_arrival(std::int64_t steady_ns) noexcept { arrival_ns_ = steady_ns; }
@@ -99,7 +124,7 @@ class SweepProcessor {
   // NAV-PVT's time accuracy (tAcc) of that UTC, s (NaN: none).
   [[nodiscard]] double gnss_time_accuracy_s() const noexcept;
   // Host UTC − the VLP-16's PPS-locked UTC at the newest sweep it stamped (NaN: none, or not locked).
-  [[nodiscard]] double host_minus_lidar_utc_s() const noexcept { return host_minus_lidar_utc_s_; }
+  [[nodiscard]] double host_minus_lidar_utc_s() const noexcept { return lanes_[0]->host_minus_lidar_utc_s; }
   // Ends the stream: the sweep in progress goes out (partial).
   void flush(SweepSink& sink);
   // Sweeps carry point_index from now on (the evaluations; the daemon does not need it).
@@ -115,9 +140,11 @@ class SweepProcessor {
   [[nodiscard]] const ActiveTrajectory& active_trajectory() const noexcept { return *active_; }
 
   [[nodiscard]] const ProcessorCounters& counters() const noexcept { return counters_; }
-  [[nodiscard]] const vlp16::StreamCounters& lidar_counters() const noexcept { return decoder_.counters(); }
-  [[nodiscard]] const std::optional<vlp16::PositionPacket>& lidar_position() const noexcept {
-    return decoder_.last_position();
+  [[nodiscard]] const vlp16::StreamCounters& lidar_counters(std::size_t lane = 0) const noexcept {
+    return lanes_[lane]->decoder.counters();
+  }
+  [[nodiscard]] const std::optional<vlp16::PositionPacket>& lidar_position(std::size_t lane = 0) const noexcept {
+    return lanes_[lane]->decoder.last_position();
   }
   [[nodiscard]] const pose_input::PoseInput& pose_input() const noexcept { return pose_input_; }
   [[nodiscard]] const pose::PoseBuffer& poses() const noexcept { return poses_; }
@@ -125,34 +152,54 @@ class SweepProcessor {
   [[nodiscard]] double trajectory_distance_m() const noexcept { return trajectory_distance_m_; }
   // Why the last packet rejected for its model was ("product id 0x28 (VLP-32C) is not
   // supported"), empty if none was.
-  [[nodiscard]] const std::string& lidar_model_reason() const noexcept { return decoder_.model_check().reason(); }
+  [[nodiscard]] const std::string& lidar_model_reason(std::size_t lane = 0) const noexcept {
+    return lanes_[lane]->decoder.model_check().reason();
+  }
   // The sweep being built (its pose status tells why a sweep is withheld).
-  [[nodiscard]] const Sweep& current() const noexcept { return sweep_; }
+  [[nodiscard]] const Sweep& current(std::size_t lane = 0) const noexcept { return lanes_[lane]->sweep; }
 
  private:
   class FrameAdapter;
+  // One LiDAR: its decoder and its sweep in progress, filtered against an ROI chain of its own
+  // (several sensors' sweeps overlap in time: each is filtered against the chain placed at its
+  // own start, for the robot's pose then).
+  struct Lane {
+    Lane(const DaemonConfig& config, const DaemonConfig::Lidar& lidar, const pose::PoseBuffer& poses);
+    DaemonConfig::Lidar lidar;
+    std::size_t index = 0;  // in lidars:
+    vlp16::StreamDecoder decoder;
+    pose::FiringPoses firing;
+    roi::RoiChain chain;
+    Sweep sweep;
+    bool in_sweep = false;
+    std::size_t unfiltered_from = 0;  // the frame's points before this one are filtered
+    Eigen::Isometry3d sweep_sensor_pose = Eigen::Isometry3d::Identity();
+    std::uint32_t sender = 0;  // several LiDARs: sensor_address (host order; 0: any)
+    double host_minus_lidar_utc_s = std::numeric_limits<double>::quiet_NaN();
+  };
   void pose_message(std::span<const std::uint8_t> bytes);
-  void start_sweep(const vlp16::Frame& frame);
+  void start_sweep(Lane& lane, const vlp16::Frame& frame);
   // Projects the robot's position on the active trajectory (within the window after the last
-  // sweep's projection, or anywhere after a jump) and places the sweep's ROI chain there.
-  void place_chain(const Eigen::Vector2d& position);
-  void add_points(const vlp16::Frame& frame, std::size_t first, SweepSink& sink);
-  void end_sweep(const vlp16::Frame& frame, SweepSink& sink);
+  // sweep's projection, or anywhere after a jump) and places the lane's ROI chain there.
+  void place_chain(Lane& lane, const Eigen::Vector2d& position);
+  void add_points(Lane& lane, const vlp16::Frame& frame, std::size_t first, SweepSink& sink);
+  void end_sweep(Lane& lane, const vlp16::Frame& frame, SweepSink& sink);
   // Filters the frame's points not filtered yet, in batches, while at least `at_least` wait.
-  void filter_points(const vlp16::Frame& frame, std::size_t at_least, SweepSink& sink);
+  void filter_points(Lane& lane, const vlp16::Frame& frame, std::size_t at_least, SweepSink& sink);
   // Places points [first, end) of the frame in the global frame (one pose per firing, or the
   // sweep's), filters them in one scan and appends the kept ones. Answers kValid, or the
   // status of a firing whose pose was not valid (the sweep is then withheld).
-  pose::PoseStatus filter_batch(const vlp16::Frame& frame, std::size_t first, std::size_t end, SweepSink& sink);
+  pose::PoseStatus filter_batch(Lane& lane, const vlp16::Frame& frame, std::size_t first, std::size_t end,
+                                SweepSink& sink);
   // outputs.raw_points: one in outputs.raw_points_decimation of the batch's placed points
   // (scratch_), by their index in the frame, appended to the sweep's raw columns.
-  void keep_raw(const vlp16::Frame& frame, std::size_t first, std::size_t end);
+  void keep_raw(Lane& lane, const vlp16::Frame& frame, std::size_t first, std::size_t end);
 
   DaemonConfig config_;
-  vlp16::StreamDecoder decoder_;
   pose::PoseBuffer poses_;
   pose_input::PoseInput pose_input_;
-  pose::FiringPoses firing_;
+  std::vector<std::unique_ptr<Lane>> lanes_;
+  std::unique_ptr<SweepMerger> merger_;  // several LiDARs
 
   std::unique_ptr<ActiveTrajectory> active_;
   std::unique_ptr<ActiveTrajectory> pending_;
@@ -160,19 +207,13 @@ class SweepProcessor {
   double s_hint_m_ = 0.0;
   double trajectory_distance_m_ = std::numeric_limits<double>::quiet_NaN();
   std::optional<std::int64_t> host_utc_offset_ns_;
-  double host_minus_lidar_utc_s_ = std::numeric_limits<double>::quiet_NaN();
   bool have_hint_ = false;
   std::optional<std::int64_t> valid_since_ns_;  // first sweep start of the current valid run
 
-  roi::RoiChain chain_;
-
-  Sweep sweep_;
-  bool in_sweep_ = false;
-  std::size_t unfiltered_from_ = 0;  // the frame's points before this one are filtered
-  Eigen::Isometry3d sweep_sensor_pose_ = Eigen::Isometry3d::Identity();
   std::vector<roi::PointXYZI> scratch_;  // one batch's points in the global frame
   roi::IndexVector kept_;
   std::int64_t arrival_ns_ = 0;
+  std::int64_t now_ns_ = 0;
   bool keep_indices_ = false;
   ProcessorCounters counters_;
 };

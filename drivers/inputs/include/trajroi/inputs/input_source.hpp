@@ -33,7 +33,8 @@ struct InputItem {
   Stream stream = Stream::kLidarData;
   std::span<const std::uint8_t> bytes;  // valid until the next call to next()
   std::int64_t receive_ns = 0;          // CLOCK_MONOTONIC (or as recorded)
-  std::uint64_t sender = 0;             // a live datagram's sender: IPv4 address << 16 | port (0: unknown)
+  std::uint64_t sender = 0;             // a datagram's sender: IPv4 address << 16 | port (0: unknown)
+  std::uint16_t port = 0;               // a datagram's destination port (0: unknown)
 };
 
 // Something the source wants said in the log (a port opened, a device unplugged, a lap).

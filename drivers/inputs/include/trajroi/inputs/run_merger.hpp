@@ -72,6 +72,7 @@ class RunMerger {
     bool have = false;
     std::int64_t t = 0;
     Stream stream = Stream::kLidarData;
+    std::uint64_t sender = 0;  // a datagram's (0: serial bytes)
     std::vector<std::uint8_t> bytes;
   };
   void fill_lidar();
