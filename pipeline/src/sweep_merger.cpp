@@ -26,11 +26,9 @@ std::size_t append_columns(PointColumns& to, const PointColumns& from, std::size
 
 }  // namespace
 
-SweepMerger::SweepMerger(std::size_t sensors, std::size_t points_per_sweep, std::size_t centres,
-                         std::size_t raw_points, MergeOptions options)
-    : options_(options),
-      capacity_((options.per_sensor ? 1 : sensors) * points_per_sweep),
-      last_ns_(sensors, 0) {
+SweepMerger::SweepMerger(std::size_t sensors, std::size_t points_per_sweep, std::size_t centres, std::size_t raw_points,
+                         MergeOptions options)
+    : options_(options), capacity_((options.per_sensor ? 1 : sensors) * points_per_sweep), last_ns_(sensors, 0) {
   merged_.reserve(capacity_, centres, (options.per_sensor ? 1 : sensors) * raw_points);
 }
 

@@ -92,21 +92,20 @@ TEST(ConfigLidars, TwoSensorsOnOnePortWithoutAddressesAreAnErrorNamingBoth) {
 
 TEST(ConfigLidars, NamesMountingsAndTheListItselfAreChecked) {
   EXPECT_NE(error_of(kHead + "lidars:\n  - {data_port: 2368}\n").find("lidars[0].name"), std::string::npos);
-  EXPECT_NE(error_of(kHead + "lidars:\n  - {name: 'front lidar'}\n").find("must be 1 … 32 letters"),
-            std::string::npos);
+  EXPECT_NE(error_of(kHead + "lidars:\n  - {name: 'front lidar'}\n").find("must be 1 … 32 letters"), std::string::npos);
   EXPECT_NE(error_of(kHead + "lidars:\n  - {name: a, sensor_address: 10.0.0.2}\n  - {name: a, sensor_address: "
                              "10.0.0.3}\n")
                 .find("lidars[1].name: is the name of another sensor"),
             std::string::npos);
   // Non-finite mountings: named with the entry.
   const std::string nan =
-      error_of(kHead + "lidars:\n  - name: a\n    mounting: {xyz: [0, .nan, 0.5]}\n  - {name: b, data_port: 2370, "
-                       "position_port: 8310}\n");
+      error_of(kHead +
+               "lidars:\n  - name: a\n    mounting: {xyz: [0, .nan, 0.5]}\n  - {name: b, data_port: 2370, "
+               "position_port: 8310}\n");
   EXPECT_NE(nan.find("lidars[0].mounting"), std::string::npos) << nan;
   EXPECT_NE(error_of(kHead + "lidars:\n  - name: a\n    mounting: {yaw_deg: .inf}\n").find("finite"),
             std::string::npos);
-  EXPECT_NE(error_of(kHead + "lidar: {data_port: 2368}\nlidars:\n  - {name: a}\n").find("not both"),
-            std::string::npos);
+  EXPECT_NE(error_of(kHead + "lidar: {data_port: 2368}\nlidars:\n  - {name: a}\n").find("not both"), std::string::npos);
   EXPECT_NE(error_of(kHead + "lidars: []\n").find("must list 1"), std::string::npos);
   EXPECT_NE(error_of(kHead + "lidars:\n  - name: a\n    min_range_m: 5\n    max_range_m: 2\n").find("lidars[0]"),
             std::string::npos);

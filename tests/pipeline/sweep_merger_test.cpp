@@ -25,8 +25,14 @@ struct Collect final : SweepSink {
   };
   std::vector<Out> out;
   void on_sweep(Sweep& s) override {
-    out.push_back({s.index, s.sensors, s.missing, s.start_ns, {s.sensor_index.begin(), s.sensor_index.end()},
-                   {s.x.begin(), s.x.end()}, {s.time_offset_ns.begin(), s.time_offset_ns.end()}, s.filtered,
+    out.push_back({s.index,
+                   s.sensors,
+                   s.missing,
+                   s.start_ns,
+                   {s.sensor_index.begin(), s.sensor_index.end()},
+                   {s.x.begin(), s.x.end()},
+                   {s.time_offset_ns.begin(), s.time_offset_ns.end()},
+                   s.filtered,
                    s.points_in});
   }
 };

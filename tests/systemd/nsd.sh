@@ -69,7 +69,7 @@ nsd_boot() {
       exec /lib/systemd/systemd --system --unit=basic.target' \
     </dev/null >"${NSD_LOG:-/dev/null}" 2>&1 &
   NSD_UNSHARE=$!
-  trap 'nsd_on_exit; nsd_end' EXIT
+  trap 'nsd_on_exit || true; nsd_end' EXIT
   local i
   for i in $(seq 1 100); do
     NSD_PID1=$(pgrep -P "$NSD_UNSHARE" -x systemd || true)
