@@ -74,7 +74,7 @@ std::vector<HealthLine> HealthMonitor::update(const StatusSnapshot& s) {
     history_.pop_front();
 
   lidar(s, out);
-  lidar_sensors(s, out);
+  lidar_sensors(s.silent_lidars, out);
   serial_ports(s, out);
   localization(s, out);
   minute_summary(s, out);
@@ -106,10 +106,16 @@ std::string HealthMonitor::lidar_names(std::uint32_t mask) const {
   return names;
 }
 
-void HealthMonitor::lidar_sensors(const StatusSnapshot& s, std::vector<HealthLine>& out) {
-  if (s.silent_lidars == silent_lidars_) return;
-  const std::uint32_t fell = s.silent_lidars & ~silent_lidars_;
-  const std::uint32_t back = silent_lidars_ & ~s.silent_lidars;
+std::vector<HealthLine> HealthMonitor::silent_lidars(std::uint32_t silent) {
+  std::vector<HealthLine> out;
+  lidar_sensors(silent, out);
+  return out;
+}
+
+void HealthMonitor::lidar_sensors(std::uint32_t silent, std::vector<HealthLine>& out) {
+  if (silent == silent_lidars_) return;
+  const std::uint32_t fell = silent & ~silent_lidars_;
+  const std::uint32_t back = silent_lidars_ & ~silent;
   if (fell != 0) {
     out.push_back({HealthLine::Level::kWarning,
                    sprintf_text("lidar: %s silent: no sweep for more than %.2f s (lidar_merge.silent_s); the other "
@@ -117,7 +123,7 @@ void HealthMonitor::lidar_sensors(const StatusSnapshot& s, std::vector<HealthLin
                                 lidar_names(fell).c_str(), config_.lidar_merge.silent_s)});
   }
   if (back != 0) out.push_back({HealthLine::Level::kInfo, "lidar: " + lidar_names(back) + " sends sweeps again"});
-  silent_lidars_ = s.silent_lidars;
+  silent_lidars_ = silent;
 }
 
 // Live only: in a replay the recording's receiver and sensor are not now.

@@ -30,6 +30,9 @@ class HealthMonitor {
 
   // The lines to log for this snapshot (faults starting or ending).
   [[nodiscard]] std::vector<HealthLine> update(const StatusSnapshot& s);
+  // Several LiDARs: the lines for the sensors silent as a sweep went out (SweepHeader::silent),
+  // said at once (the snapshots come once a second).
+  [[nodiscard]] std::vector<HealthLine> silent_lidars(std::uint32_t silent);
   // The state in words, for STATUS=.
   [[nodiscard]] const std::string& state() const noexcept { return state_; }
 
@@ -66,7 +69,7 @@ class HealthMonitor {
   void localization(const StatusSnapshot& s, std::vector<HealthLine>& out);
   void minute_summary(const StatusSnapshot& s, std::vector<HealthLine>& out);
   // Several LiDARs: each one that falls silent or sends again, said.
-  void lidar_sensors(const StatusSnapshot& s, std::vector<HealthLine>& out);
+  void lidar_sensors(std::uint32_t silent, std::vector<HealthLine>& out);
   [[nodiscard]] std::string lidar_names(std::uint32_t mask) const;
   // The host clock against GNSS time and the VLP-16's; the VLP-16's PPS.
   void clocks(const StatusSnapshot& s, std::vector<HealthLine>& out);

@@ -13,6 +13,19 @@
 #include "trajroi/vlp16/model.hpp"
 
 namespace trajroi::daemon {
+namespace {
+
+void say(const std::vector<HealthLine>& lines) {
+  for (const HealthLine& line : lines) {
+    if (line.level == HealthLine::Level::kWarning) {
+      log::warn("{}", line.text);
+    } else {
+      log::info("{}", line.text);
+    }
+  }
+}
+
+}  // namespace
 
 Publisher::Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, bool replay,
                      const pipeline::ActiveTrajectory& trajectory)
@@ -48,6 +61,8 @@ void Publisher::publish_sweep(const pipeline::Sweep& s) {
   // A sweep filtered against another trajectory: it is the active one now (the viewers' line).
   if (trajectories_.activate(s.trajectory_id)) sender_.send_trajectory(trajectories_.active());
   sender_.send_pose(s);
+  // Several LiDARs: one falling silent is said as the first sweep without it goes out.
+  if (s.sensors != 0) say(health_.silent_lidars(s.silent));
   if (s.filtered) {
     sender_.send_roi(s);
     sender_.encode_points(s);
@@ -144,13 +159,7 @@ void Publisher::publish_status(const StatusSnapshot& s) {
       m.state, m.sweeps, m.sweeps_published, m.sweeps_without_pose, m.points_in, m.points_kept, kept_pct,
       m.latency_ms_p50, m.latency_ms_p99, m.ring_drops, m.lost_packets, pose_inputs_text(s, config_), rtk_text(m),
       m.trajectory_id, recording_text());
-  for (const HealthLine& line : lines) {
-    if (line.level == HealthLine::Level::kWarning) {
-      log::warn("{}", line.text);
-    } else {
-      log::info("{}", line.text);
-    }
-  }
+  say(lines);
   sweep_warnings_.flush(host::monotonic_ns());
   if (!s.final) sd_notify(0, ("STATUS=" + health_.state()).c_str());
   latency_.end_window();

@@ -147,6 +147,8 @@ void fill_snapshot(const pipeline::SweepProcessor& p, const Pipeline& pipeline, 
     s[C::kSerialDisconnects] += lane->disconnects.load(std::memory_order_relaxed);
     s[C::kLidarSourceErrors] += lane->errors.load(std::memory_order_relaxed);
   }
+  // Several LiDARs on one port: a sender that is none of theirs, dropped by the processor.
+  s[C::kLidarRejectedSource] += p.counters().lidar_unknown_sender;
   s[C::kChronySamples] = pipeline.chrony ? pipeline.chrony->samples() : 0;
   s[C::kRingDropsSweeps] = pipeline.sweeps.dropped();
   s[C::kRingDropsStatus] = pipeline.status->dropped();

@@ -39,6 +39,7 @@ bool SweepMerger::silent(std::size_t sensor, std::int64_t now_ns) const noexcept
 
 void SweepMerger::add(std::size_t sensor, const Sweep& sweep, std::int64_t now_ns, SweepSink& sink) {
   if (first_input_ns_ == 0) first_input_ns_ = now_ns;
+  now_ns_ = now_ns;
   const auto bit = static_cast<std::uint32_t>(1U << sensor);
   if (options_.per_sensor) {
     last_ns_[sensor] = now_ns;
@@ -66,6 +67,7 @@ void SweepMerger::add(std::size_t sensor, const Sweep& sweep, std::int64_t now_n
 
 void SweepMerger::tick(std::int64_t now_ns, SweepSink& sink) {
   if (first_input_ns_ == 0) first_input_ns_ = now_ns;
+  now_ns_ = now_ns;
   if (!open_) return;
   // A sensor that fell silent while the window was open is not waited for any longer either.
   for (std::size_t i = 0; i < last_ns_.size(); ++i) {
@@ -121,6 +123,10 @@ void SweepMerger::append(std::size_t sensor, const Sweep& sweep) {
 void SweepMerger::emit(SweepSink& sink) {
   merged_.index = index_++;
   merged_.missing = waited_for_ & ~merged_.sensors;
+  merged_.silent = 0;
+  for (std::size_t i = 0; i < last_ns_.size(); ++i) {
+    if ((merged_.sensors & (1U << i)) == 0 && silent(i, now_ns_)) merged_.silent |= 1U << i;
+  }
   if (merged_.missing != 0) ++incomplete_;
   ++merged_count_;
   sink.on_sweep(merged_);

@@ -72,6 +72,7 @@ struct SweepHeader {
   // LiDAR of lidar:); `missing` those the merge waited for and did not get.
   std::uint32_t sensors = 0;
   std::uint32_t missing = 0;
+  std::uint32_t silent = 0;  // those silent (no sweep for lidar_merge.silent_s) as it went out
 
   // The ROI chain.
   std::int32_t trajectory_id = 0;
