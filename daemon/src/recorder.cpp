@@ -18,16 +18,27 @@ void record_to(Pipeline& pipeline, const std::filesystem::path& dir) {
   serial::RecordingWriter imu((dir / inputs::kImuFile).string());
   std::unique_ptr<serial::RecordingWriter> pose;  // made at the first pose message
   Lane<InputSlot>& ring = *pipeline.record;
+  const bool several = pipeline.config.all_lidars().size() > 1;
   for (;;) {
     bool any = false;
     while (InputSlot* s = ring.front()) {
       const std::span<const std::uint8_t> bytes(s->bytes.data(), s->size);
       switch (s->stream) {
+        // One LiDAR: on the standard ports from the factory address. Several: each datagram
+        // with its sender and port, which tell the sensors apart in the replay.
         case inputs::Stream::kLidarData:
-          pcap.write(s->receive_ns, vlp16::kDataPort, bytes);
+          if (several) {
+            pcap.write(s->receive_ns, s->port != 0 ? s->port : vlp16::kDataPort, bytes, s->sender);
+          } else {
+            pcap.write(s->receive_ns, vlp16::kDataPort, bytes);
+          }
           break;
         case inputs::Stream::kLidarPosition:
-          pcap.write(s->receive_ns, vlp16::kPositionPort, bytes);
+          if (several) {
+            pcap.write(s->receive_ns, s->port != 0 ? s->port : vlp16::kPositionPort, bytes, s->sender);
+          } else {
+            pcap.write(s->receive_ns, vlp16::kPositionPort, bytes);
+          }
           break;
         case inputs::Stream::kGnss:
           gnss.write(serial::Chunk{bytes, s->receive_ns});

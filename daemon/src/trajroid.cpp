@@ -73,6 +73,8 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
     inputs::RecordedOptions recorded;
     recorded.rate = options.rate;
     recorded.loop = options.loop;
+    for (const DaemonConfig::Lidar& l : config.all_lidars())
+      recorded.lidar_ports.emplace_back(l.data_port, l.position_port);
     const std::size_t ring =
         options.rate == 0.0 ? std::min(config.buffers.lidar_packets, kExactReplayRing) : config.buffers.lidar_packets;
     pipeline.add_input(std::make_unique<inputs::RecordedInput>(*options.replay, recorded), ring, "trajroid-replay",

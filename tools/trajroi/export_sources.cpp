@@ -90,10 +90,15 @@ SourceSummary replay_run_folder(const fs::path& dir, const fs::path& config_path
     throw std::runtime_error(file.string() + ": no trajroid configuration for the run folder (--config)");
   const daemon::DaemonConfig config = daemon::load_daemon_config(file);
   pipeline::SweepProcessor processor(config, daemon::load_trajectory(daemon::TrajectorySource::from(config)));
+  inputs::LidarPorts ports;
+  for (const daemon::DaemonConfig::Lidar& l : config.all_lidars())
+    ports.emplace_back(l.data_port, l.position_port);  // several LiDARs record theirs
   inputs::RunMerger merger(
-      dir, inputs::RunStreams{
-               true, config.pose_source != daemon::PoseSource::kLcm && config.pose_source != daemon::PoseSource::kFixed,
-               config.pose_source == daemon::PoseSource::kGnssImu});
+      dir,
+      inputs::RunStreams{
+          true, config.pose_source != daemon::PoseSource::kLcm && config.pose_source != daemon::PoseSource::kFixed,
+          config.pose_source == daemon::PoseSource::kGnssImu},
+      0, ports);
   const auto total = static_cast<double>(fs::file_size(dir / inputs::kLidarFile));
   CloudSink sink(on_sweep);
   inputs::InputItem item;

@@ -9,7 +9,7 @@ namespace trajroi::inputs {
 RecordedInput::RecordedInput(std::filesystem::path dir, RecordedOptions options)
     : dir_(std::move(dir)),
       options_(options),
-      merger_(std::make_unique<RunMerger>(dir_, options.streams)),
+      merger_(std::make_unique<RunMerger>(dir_, options.streams, 0, options.lidar_ports)),
       pacer_(options.rate) {}
 
 RecordedInput::~RecordedInput() = default;
@@ -44,7 +44,7 @@ RecordedInput::Next RecordedInput::next(InputItem& item, std::chrono::millisecon
     if (!options_.loop || merger_->first_ns() > merger_->last_ns()) return Next::kEnd;
     shift_ns_ += merger_->last_ns() - merger_->first_ns() + kLapGap_ns;
     oversize_ += merger_->oversize();
-    merger_ = std::make_unique<RunMerger>(dir_, options_.streams, shift_ns_);
+    merger_ = std::make_unique<RunMerger>(dir_, options_.streams, shift_ns_, options_.lidar_ports);
     missing_reported_ = merger_->missing().size();  // said once, at the first lap
     error_reported_ = false;
     notice_ = {Notice::Level::kInfo, "replay: lap " + std::to_string(++lap_)};

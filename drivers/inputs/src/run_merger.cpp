@@ -10,10 +10,17 @@ namespace trajroi::inputs {
 
 namespace fs = std::filesystem;
 
-RunMerger::RunMerger(const fs::path& dir, RunStreams streams, std::int64_t shift_ns) : shift_ns_(shift_ns) {
+RunMerger::RunMerger(const fs::path& dir, RunStreams streams, std::int64_t shift_ns, const LidarPorts& lidar_ports)
+    : shift_ns_(shift_ns) {
+  position_ports_ = {vlp16::kPositionPort};
   if (streams.lidar) {
     vlp16::PcapOptions options;
     options.ports = {vlp16::kDataPort, vlp16::kPositionPort};
+    for (const auto& [data, position] : lidar_ports) {
+      options.ports.push_back(data);
+      options.ports.push_back(position);
+      position_ports_.push_back(position);
+    }
     pcap_ = std::make_unique<vlp16::PcapSource>(dir / kLidarFile, options);
   }
   const auto open_serial = [&](bool wanted, const char* name) -> std::unique_ptr<serial::ReplaySource> {
@@ -34,7 +41,8 @@ RunMerger::RunMerger(const fs::path& dir, RunStreams streams, std::int64_t shift
   fill_serial(pose_.get(), pose_next_, Stream::kPose);
 }
 
-RunMerger::RunMerger(const RunFiles& files) : lidar_start_ns_(files.lidar_start_ns) {
+RunMerger::RunMerger(const RunFiles& files)
+    : position_ports_{vlp16::kPositionPort}, lidar_start_ns_(files.lidar_start_ns) {
   if (!files.lidar.empty()) {
     vlp16::PcapOptions options;
     options.ports = {vlp16::kDataPort, vlp16::kPositionPort};
@@ -69,8 +77,11 @@ void RunMerger::fill_lidar() {
     lidar_.have = true;
     if (lidar_start_ns_ && !lidar_shift_ns_) lidar_shift_ns_ = *lidar_start_ns_ - d.receive_time_ns;
     lidar_.t = d.receive_time_ns + lidar_shift_ns_.value_or(0) + shift_ns_;
-    lidar_.stream = d.destination_port == vlp16::kPositionPort ? Stream::kLidarPosition : Stream::kLidarData;
+    const bool position =
+        std::find(position_ports_.begin(), position_ports_.end(), d.destination_port) != position_ports_.end();
+    lidar_.stream = position ? Stream::kLidarPosition : Stream::kLidarData;
     lidar_.sender = d.sender;
+    lidar_.port = d.destination_port;
     lidar_.bytes.assign(d.payload.begin(), d.payload.end());
     return;
   }
@@ -107,6 +118,7 @@ bool RunMerger::next(InputItem& item) {
   out_.swap(p->bytes);
   item.stream = p->stream;
   item.sender = p->sender;
+  item.port = p->port;
   item.receive_ns = p->t;
   item.bytes = out_;
   first_ns_ = std::min(first_ns_, p->t);

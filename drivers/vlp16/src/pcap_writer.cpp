@@ -29,7 +29,10 @@ PcapWriter::PcapWriter(const std::filesystem::path& path) : handle_(std::make_un
 
 PcapWriter::~PcapWriter() = default;
 
-void PcapWriter::write(std::int64_t time_ns, std::uint16_t port, std::span<const std::uint8_t> payload) {
+void PcapWriter::write(std::int64_t time_ns, std::uint16_t port, std::span<const std::uint8_t> payload,
+                       std::uint64_t sender) {
+  const auto address = sender != 0 ? static_cast<std::uint32_t>(sender >> 16) : 0xC0A801C9U;  // 192.168.1.201
+  const auto source_port = sender != 0 ? static_cast<std::uint16_t>(sender & 0xFFFF) : port;
   if (handle_->dumper == nullptr) throw std::runtime_error(path_.string() + ": written after close");
   frame_.assign({0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0x60, 0x76, 0x88, 0x00, 0x00, 0x01, 0x08, 0x00});
   const std::size_t ip_start = frame_.size();
@@ -46,10 +49,10 @@ void PcapWriter::write(std::int64_t time_ns, std::uint16_t port, std::span<const
                                17,
                                0,
                                0,
-                               192,
-                               168,
-                               1,
-                               201,
+                               static_cast<std::uint8_t>(address >> 24),
+                               static_cast<std::uint8_t>(address >> 16),
+                               static_cast<std::uint8_t>(address >> 8),
+                               static_cast<std::uint8_t>(address),
                                255,
                                255,
                                255,
@@ -65,8 +68,8 @@ void PcapWriter::write(std::int64_t time_ns, std::uint16_t port, std::span<const
   frame_[ip_start + 10] = static_cast<std::uint8_t>(checksum >> 8);
   frame_[ip_start + 11] = static_cast<std::uint8_t>(checksum);
   const auto udp_length = static_cast<std::uint16_t>(8 + payload.size());
-  const std::uint8_t udp[8] = {static_cast<std::uint8_t>(port >> 8),
-                               static_cast<std::uint8_t>(port),
+  const std::uint8_t udp[8] = {static_cast<std::uint8_t>(source_port >> 8),
+                               static_cast<std::uint8_t>(source_port),
                                static_cast<std::uint8_t>(port >> 8),
                                static_cast<std::uint8_t>(port),
                                static_cast<std::uint8_t>(udp_length >> 8),

@@ -17,6 +17,7 @@ struct RecordedOptions {
   double rate = 0.0;  // 0 as fast as possible, 1 real time, N × real time
   bool loop = false;
   RunStreams streams;
+  LidarPorts lidar_ports;
 };
 
 class RecordedInput final : public InputSource {

@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "trajroi/inputs/input_source.hpp"
@@ -29,6 +30,10 @@ struct RunStreams {
   bool lidar = true, gnss = true, imu = true;
 };
 
+// The pcap's LiDAR ports beside the standard 2368/8308: data and position pairs (several LiDARs
+// record theirs).
+using LidarPorts = std::vector<std::pair<std::uint16_t, std::uint16_t>>;
+
 // Captures named one by one instead of a run folder (trajroi feed): a pcap, and serial files
 // (recordings, or raw logs timed by their options: serial::RawTiming). Empty paths are silent
 // streams.
@@ -45,7 +50,8 @@ class RunMerger {
   // Opens the folder's recordings (the streams asked for). A missing gnss.trjb or imu.trjb
   // leaves that stream silent (missing() names it); a missing or unreadable lidar.pcap
   // throws std::runtime_error naming it. `shift_ns` is added to every recorded time.
-  RunMerger(const std::filesystem::path& dir, RunStreams streams = {}, std::int64_t shift_ns = 0);
+  RunMerger(const std::filesystem::path& dir, RunStreams streams = {}, std::int64_t shift_ns = 0,
+            const LidarPorts& lidar_ports = {});
   // The same merge over captures named one by one. Throws std::runtime_error naming a file that
   // cannot be read (or, raw, timed).
   explicit RunMerger(const RunFiles& files);
@@ -73,9 +79,11 @@ class RunMerger {
     std::int64_t t = 0;
     Stream stream = Stream::kLidarData;
     std::uint64_t sender = 0;  // a datagram's (0: serial bytes)
+    std::uint16_t port = 0;    // its destination port
     std::vector<std::uint8_t> bytes;
   };
   void fill_lidar();
+  std::vector<std::uint16_t> position_ports_;
   void fill_serial(serial::ReplaySource* source, Pending& p, Stream stream);
   [[nodiscard]] Pending* earliest() noexcept;
 

@@ -56,9 +56,9 @@ class PcapSource final : public PacketSource {
 };
 
 // Writes UDP payloads to a pcap file (nanosecond timestamps), wrapped in Ethernet + IPv4 +
-// UDP headers as the sensor sends them: broadcast from the factory address 192.168.1.201,
-// Velodyne's OUI 60:76:88, UDP checksum 0 (allowed on IPv4). Throws std::runtime_error naming
-// the file when it cannot be created or written.
+// UDP headers as the sensor sends them: broadcast from the factory address 192.168.1.201 (or
+// the datagram's own sender), Velodyne's OUI 60:76:88, UDP checksum 0 (allowed on IPv4). Throws std::runtime_error
+// naming the file when it cannot be created or written.
 class PcapWriter {
  public:
   explicit PcapWriter(const std::filesystem::path& path);
@@ -66,7 +66,8 @@ class PcapWriter {
   PcapWriter(const PcapWriter&) = delete;
   PcapWriter& operator=(const PcapWriter&) = delete;
 
-  void write(std::int64_t time_ns, std::uint16_t port, std::span<const std::uint8_t> payload);
+  // `sender`: IPv4 address << 16 | source port, as Datagram::sender (0: 192.168.1.201 from `port`).
+  void write(std::int64_t time_ns, std::uint16_t port, std::span<const std::uint8_t> payload, std::uint64_t sender = 0);
   void flush();
   // Flushes and closes; throws when the data could not be written.
   void close();
