@@ -272,7 +272,10 @@ void HealthMonitor::update_state(const StatusSnapshot& s, const StatusSnapshot& 
   if (!problems.empty()) {
     state_ = problems;
   } else if (published > 0 && since_s > 0.0) {
-    state_ = sprintf_text("publishing %.1f sweeps/s", static_cast<double>(published) / since_s);
+    state_ = config_.lidars.size() > 1
+                 ? sprintf_text("publishing %.1f sweeps/s of %zu LiDARs (%s)", static_cast<double>(published) / since_s,
+                                config_.lidars.size(), config_.lidar_merge.per_sensor ? "each alone" : "merged")
+                 : sprintf_text("publishing %.1f sweeps/s", static_cast<double>(published) / since_s);
   } else {
     state_ = "receiving LiDAR data, no sweep published in the last second";
   }

@@ -87,6 +87,44 @@ TEST(Health, AHealthyDaemonSaysNothingAndPublishes) {
   EXPECT_EQ(said.state, "publishing 10.0 sweeps/s");
 }
 
+// Several LiDARs: the state says how many and how they go out; one falling silent is named with
+// its address and port, in the log once (whether a sweep or a snapshot says it first) and in the
+// state while it lasts, and its return too.
+TEST(Health, ASilentLidarOfSeveralIsNamedOnceAndInTheStateWhileItLasts) {
+  DaemonConfig c = live_config();
+  DaemonConfig::Lidar rear = c.lidar;
+  rear.name = "rear";
+  rear.sensor_address = "192.168.1.202";
+  c.lidar.name = "front";
+  c.lidars = {c.lidar, rear};
+  HealthMonitor monitor(c, true, 0);
+  StatusSnapshot s;
+  s.trajectory_distance_m = std::numeric_limits<double>::quiet_NaN();
+  s.host_minus_gnss_utc_s = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::string> said;
+  for (int t = 1; t <= 6; ++t) {
+    s.steady_ns = t * kSecond;
+    healthy(s, t);
+    s.silent_lidars = t >= 3 && t <= 4 ? 2U : 0U;
+    if (t == 3) {  // the first sweep without it, before the snapshot
+      for (const HealthLine& l : monitor.silent_lidars(2U))
+        said.push_back(l.text);
+    }
+    for (const HealthLine& l : monitor.update(s))
+      said.push_back(l.text);
+    if (t == 2) {
+      EXPECT_EQ(monitor.state(), "publishing 10.0 sweeps/s of 2 LiDARs (merged)");
+    }
+    if (t == 4) {
+      EXPECT_EQ(monitor.state(), "LiDAR rear (192.168.1.202 → UDP 2368): silent, not merged");
+    }
+  }
+  ASSERT_EQ(said.size(), 2U);
+  EXPECT_EQ(said[0].rfind("lidar: rear (192.168.1.202 → UDP 2368) silent: no sweep for more than 0.50 s", 0), 0U)
+      << said[0];
+  EXPECT_EQ(said[1], "lidar: rear (192.168.1.202 → UDP 2368) sends sweeps again");
+}
+
 TEST(Health, NoLidarDatagramsAreNamedWithThePortWithinFiveSecondsAndTheirReturnToo) {
   const Said said = run(live_config(), 12, [](StatusSnapshot& s, int t) {
     healthy(s, t);

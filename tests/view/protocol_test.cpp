@@ -126,7 +126,8 @@ std::uint32_t u32(const std::vector<std::uint8_t>& b, std::size_t at) {
 
 TEST(Frames, SweepLayoutIsWhatThePageReads) {
   const std::vector<float> x = {1.5f, -2.0f}, y = {3.0f, 4.0f}, z = {0.25f, -0.5f};
-  const std::vector<std::uint8_t> intensity = {7, 200};
+  const std::vector<std::uint8_t> intensity = {7, 200}, sensor = {1, 0};
+  const std::vector<std::string> names = {"front", "rear"};
   const std::vector<double> cx = {10.0}, cy = {-3.0}, th = {0.5};
   SweepView s;
   s.sweep_index = 1234;
@@ -137,6 +138,8 @@ TEST(Frames, SweepLayoutIsWhatThePageReads) {
   s.y = y;
   s.z = z;
   s.intensity = intensity;
+  s.sensor = sensor;
+  s.sensor_names = names;
   const std::vector<std::uint8_t> f = encode_sweep(s);
   EXPECT_EQ(u32(f, 0), kFrameMagic);
   EXPECT_EQ(std::string(f.begin(), f.begin() + 4), "TRV1");
@@ -147,6 +150,7 @@ TEST(Frames, SweepLayoutIsWhatThePageReads) {
   EXPECT_NE(header.find("\"sweep\":1234"), std::string::npos) << header;
   EXPECT_NE(header.find("\"n\":2"), std::string::npos) << header;
   EXPECT_NE(header.find("\"centres\":[[10,-3,0.5]]"), std::string::npos) << header;
+  EXPECT_NE(header.find("\"sensors\":[\"front\",\"rear\"]"), std::string::npos) << header;
   float xyz[6];
   std::memcpy(xyz, f.data() + 12 + json, sizeof xyz);
   EXPECT_EQ(xyz[0], 1.5f);
@@ -155,7 +159,9 @@ TEST(Frames, SweepLayoutIsWhatThePageReads) {
   EXPECT_EQ(xyz[3], -2.0f);
   EXPECT_EQ(f[12 + json + 24], 7);
   EXPECT_EQ(f[12 + json + 25], 200);
-  EXPECT_EQ(f.size(), 12 + json + 24 + 4);
+  EXPECT_EQ(f[12 + json + 28], 1);  // the sensors, after the intensities padded to 4 bytes
+  EXPECT_EQ(f[12 + json + 29], 0);
+  EXPECT_EQ(f.size(), 12 + json + 24 + 4 + 4);
 }
 
 TEST(Frames, JsonEscapesAndNulls) {

@@ -204,7 +204,7 @@ def main():
 
     width, height, pixel = png.read_png(shot)
     background = (0x10, 0x14, 0x18)
-    inside = [(x, y) for x, y in spots if 2 <= x < width - 2 and 2 <= y < height - 2]
+    inside = [(x, y) for x, y, _sensor in spots if 2 <= x < width - 2 and 2 <= y < height - 2]
     lit = 0
     for x, y in inside:
         near = [pixel(int(x) + dx, int(y) + dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1)]

@@ -171,6 +171,8 @@ class Viewer {
     s.y = m->y;
     s.z = m->z;
     s.intensity = std::span(reinterpret_cast<const std::uint8_t*>(m->intensity.data()), m->intensity.size());
+    s.sensor = std::span(reinterpret_cast<const std::uint8_t*>(m->sensor.data()), m->sensor.size());
+    s.sensor_names = m->sensor_names;
     const auto roi = rois_.find(m->sweep_index);
     if (roi != rois_.end()) {
       const trajroi::roi_t& r = roi->second;

@@ -154,6 +154,10 @@ std::vector<std::uint8_t> encode_sweep(const SweepView& s) {
       .field("partial", s.partial)
       .field("points_in", std::int64_t{s.points_in})
       .field("n", static_cast<std::int64_t>(n));
+  j.begin_array("sensors");
+  for (const std::string& name : s.sensor_names)
+    j.value(std::string_view(name));
+  j.end_array();
   j.key("pose").begin_object();
   j.field("valid", s.pose_valid).field("x", s.robot_x_m).field("y", s.robot_y_m).field("z", s.robot_z_m);
   j.field("yaw", s.yaw_rad).end_object();
@@ -172,7 +176,10 @@ std::vector<std::uint8_t> encode_sweep(const SweepView& s) {
   const std::span<const std::uint8_t> intensity = s.intensity.first(std::min(n, s.intensity.size()));
   std::vector<std::uint8_t> shades(intensity.begin(), intensity.end());
   shades.resize(n, 0);
-  const std::span<const std::uint8_t> arrays[] = {bytes_of(xyz), bytes_of(shades)};
+  const std::span<const std::uint8_t> sensor = s.sensor.first(std::min(n, s.sensor.size()));
+  std::vector<std::uint8_t> sensors(sensor.begin(), sensor.end());
+  sensors.resize(n, 0);
+  const std::span<const std::uint8_t> arrays[] = {bytes_of(xyz), bytes_of(shades), bytes_of(sensors)};
   return encode_frame(FrameKind::kSweep, j.text(), arrays);
 }
 

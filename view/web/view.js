@@ -1,7 +1,7 @@
 // trajroi view's page: draws what trajroid publishes, as `trajroi view` forwards it over a
 // WebSocket (/ws). Frames (view/include/trajroi/view/frames.hpp): "TRV1", uint32 kind, uint32
 // JSON header length, the JSON header, then the kind's arrays (little-endian, 4-byte aligned).
-// Drawn: the kept points of the newest sweep (coloured by height or intensity), the decoded
+// Drawn: the kept points of the newest sweep (coloured by height, intensity or sensor), the decoded
 // points before the ROI in grey (outputs.raw_points), the ROI chain placed for that sweep, the
 // active trajectory and the robot. The page writes what it drew in #counters, and tells the
 // server each sweep it drew ("drawn <index>") for the latency figures.
@@ -112,13 +112,23 @@
       for (var c = 0; c < 3; ++c) lut[3 * i + c] = Math.round(a[c + 1] + u * (b[c + 1] - a[c + 1]));
     }
   })();
+  // Several LiDARs: one colour each, in lidars: order (none of the ROI chain's, the trajectory's,
+  // the robot's or the raw points').
+  var SENSOR_COLOURS = [[255, 140, 40], [110, 255, 110], [170, 120, 255], [255, 255, 255], [255, 90, 90],
+                        [90, 140, 255], [200, 200, 90], [255, 170, 200]];
+  window.trajroiSensorColours = SENSOR_COLOURS;
   var colourBy = 'height';
   var colourScratch = new Uint8Array(0);
-  function colours(xyz, intensity, groundZ) {
+  function colours(xyz, intensity, groundZ, sensor) {
     var n = intensity.length;
     if (colourScratch.length < 3 * n) colourScratch = new Uint8Array(3 * n);
     var out = colourScratch, i, k;
-    if (colourBy === 'height') {
+    if (colourBy === 'sensor') {
+      for (i = 0; i < n; ++i) {
+        var c = SENSOR_COLOURS[sensor[i] % SENSOR_COLOURS.length];
+        out[3 * i] = c[0]; out[3 * i + 1] = c[1]; out[3 * i + 2] = c[2];
+      }
+    } else if (colourBy === 'height') {
       var lo = groundZ - 2.0, scale = 255 / 5.0;  // 5 m of height over the map
       for (i = 0; i < n; ++i) {
         k = Math.max(0, Math.min(255, Math.round((xyz[3 * i + 2] - lo) * scale))) * 3;
@@ -146,7 +156,7 @@
     for (var k = 0; k < count && n > 0; ++k) {
       var i = Math.floor(k * n / count);
       v.set(position.array[3 * i], position.array[3 * i + 1], position.array[3 * i + 2]).project(camera);
-      out.push([(v.x + 1) / 2 * w, (1 - v.y) / 2 * h]);
+      out.push([(v.x + 1) / 2 * w, (1 - v.y) / 2 * h, lastIntensity ? lastIntensity.sensor[i] : 0]);
     }
     return out;
   };
@@ -206,7 +216,25 @@
     return shapes;
   }
 
-  function onSweep(header, xyz, intensity) {
+  // The sensors' names beside their colours (several LiDARs), as the newest sweep gives them.
+  var sensorsShown = '';
+  function showSensors(names) {
+    var text = names.join(',');
+    if (text === sensorsShown) return;
+    sensorsShown = text;
+    var box = document.getElementById('sensors');
+    box.textContent = '';
+    names.forEach(function (name, i) {
+      var c = SENSOR_COLOURS[i % SENSOR_COLOURS.length], swatch = document.createElement('span');
+      swatch.className = 'swatch';
+      swatch.style.background = 'rgb(' + c.join(',') + ')';
+      box.appendChild(swatch);
+      box.appendChild(document.createTextNode(name + ' '));
+    });
+    document.getElementById('colour-sensor').disabled = names.length < 2;
+  }
+
+  function onSweep(header, xyz, intensity, sensor) {
     ++stats.sweepsReceived;
     var pose = header.pose;
     if (pose && pose.valid) {
@@ -227,8 +255,9 @@
       robot.visible = true;
     }
     lastSweep = header;
-    lastIntensity = { xyz: xyz, intensity: intensity };
-    kept.set(xyz, colours(xyz, intensity, robotZ));
+    lastIntensity = { xyz: xyz, intensity: intensity, sensor: sensor };
+    showSensors(header.sensors || []);
+    kept.set(xyz, colours(xyz, intensity, robotZ, sensor));
     stats.roiShapes = drawRoi(header.roi, robotZ);
     stats.lastSweep = header.sweep;
     stats.pointsDrawn = kept.drawn();
@@ -329,7 +358,9 @@
     if (kind === KIND.sweep) {
       if (paused) return;
       var xyz = new Float32Array(buffer, at, 3 * header.n);
-      onSweep(header, xyz, new Uint8Array(buffer, at + 12 * header.n, header.n));
+      var sensorAt = at + 12 * header.n + Math.ceil(header.n / 4) * 4;  // after the intensities, 4-aligned
+      onSweep(header, xyz, new Uint8Array(buffer, at + 12 * header.n, header.n),
+              new Uint8Array(buffer, sensorAt, header.n));
     } else if (kind === KIND.raw) {
       if (paused) return;
       onRaw(header, new Float32Array(buffer, at, 3 * header.n));
@@ -381,7 +412,9 @@
   Array.prototype.forEach.call(document.querySelectorAll('input[name=colour]'), function (r) {
     r.addEventListener('change', function () {
       colourBy = r.value;
-      if (lastIntensity) kept.set(lastIntensity.xyz, colours(lastIntensity.xyz, lastIntensity.intensity, robotZ));
+      if (lastIntensity) {
+        kept.set(lastIntensity.xyz, colours(lastIntensity.xyz, lastIntensity.intensity, robotZ, lastIntensity.sensor));
+      }
       dirty = true;
     });
   });

@@ -14,7 +14,8 @@
 namespace trajroi::view {
 
 enum class FrameKind : std::uint32_t {
-  kSweep = 1,       // header: sweep, pose, ROI chain; arrays: float32 xyz[3n], uint8 intensity[n]
+  kSweep = 1,       // header: sweep, sensors, pose, ROI chain; arrays: float32 xyz[3n], uint8 intensity[n],
+                    // uint8 sensor[n]
   kRawPoints = 2,   // header: sweep index; arrays: float32 xyz[3n] (decoded points before the ROI)
   kTrajectory = 3,  // header: id; arrays: float32 xy[2n]
   kStatus = 4,      // header only: the status in words and figures
@@ -65,6 +66,9 @@ struct SweepView {
   bool have_roi = false;  // false: no roi_t of this sweep came
   std::span<const float> x, y, z;
   std::span<const std::uint8_t> intensity;
+  // The sensor of each point (points_t.sensor) and the sensors' names; empty: one LiDAR.
+  std::span<const std::uint8_t> sensor;
+  std::span<const std::string> sensor_names;
 };
 
 // The envelope around `json` and `arrays` (each padded to 4 bytes).
