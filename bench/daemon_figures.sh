@@ -3,7 +3,9 @@
 # (tests/daemon/corridor.yaml, 28.8 s) replayed through the daemon publishing over LCM on
 # loopback, (1) at real-time pace: latency from the last packet of a sweep to its LCM
 # publication (p50, p99), CPU time per second of data, ring drops; (2) as fast as possible:
-# the replay speed as a multiple of real time. Each kind is run TRAJROI_FIGURE_RUNS times (5)
+# the replay speed as a multiple of real time; (3) four VLP-16 streams (the same data from four
+# senders, bench/four_lidars.py, merged) at real-time pace: the pipeline's CPU and latency.
+# Each kind is run TRAJROI_FIGURE_RUNS times (5)
 # and its medians are the figures. Beside each real-time run, `trajroi machine` says how
 # steadily the machine gave a thread its CPU meanwhile (its longest slow spell).
 # Usage: bench/daemon_figures.sh [BUILD_DIR]   (default build/release)
@@ -22,16 +24,16 @@ duration=$(awk '/^duration_s/ {print $2}' "$run/summary.txt")
 # the longest spell a fixed piece of arithmetic ran over twice as slow as at full speed, and how
 # slow; a latency tail measured during such a spell is the machine's.
 steady="$(dirname "$run")/steady.txt"
-figures() {  # rate → "latency_p50 latency_p99 drops wall_s cpu_s pipeline_cpu_s spell_ms spell_factor run_s steal_ms"
-  local log start end witness= steal0
+figures() {  # rate [run] → "latency_p50 latency_p99 drops wall_s cpu_s pipeline_cpu_s spell_ms spell_factor run_s steal_ms"
+  local log start end witness= steal0 folder=${2:-$run}
   steal0=$(steal_ms)
   if [ "$1" = realtime ]; then
     "$build/tools/trajroi" machine --seconds "$duration" --brief >"$steady" 2>/dev/null &
     witness=$!
   fi
   start=$EPOCHREALTIME  # wall time to the millisecond (time's %e has 10 ms steps)
-  log=$( { /usr/bin/time -f "TIME %e %U %S" "$build/daemon/trajroid" --config "$run/trajroid.yaml" --replay "$run" \
-           --rate "$1" 2>&1; } 2>&1 )
+  log=$( { /usr/bin/time -f "TIME %e %U %S" "$build/daemon/trajroid" --config "$folder/trajroid.yaml" \
+           --replay "$folder" --rate "$1" 2>&1; } 2>&1 )
   end=$EPOCHREALTIME
   local summary
   summary=$(grep "summary:" <<<"$log")
@@ -91,3 +93,12 @@ cpu=$(awk '{print $5}' <<<"$fast" | median)
 cores=$(nproc)
 awk -v c="$cpu" -v n="$cores" -v d="$duration" -v w="$wall" -v st="$(awk '{printf "%s ", $10}' <<<"$fast")" \
   'BEGIN {printf "as fast as possible: CPU of the whole process %.3f s (median) = %.0f %% of %d cores over the wall; spread perfectly over them it needs %.3f s = %.0fx at most; the host'"'"'s steal each run: %sms\n", c, 100 * c / (n * w), n, c / n, d * n / c, st}'
+# Four VLP-16 streams at real-time pace, merged into one points_t per window.
+run4="$(dirname "$run")/four"
+"${PYTHON:-python3}" bench/four_lidars.py "$run" "$run4"
+four=$(for _ in $(seq 1 "$runs"); do figures realtime "$run4"; done)
+p99=$(awk '{print $2}' <<<"$four" | median)
+pipeline=$(awk '{print $6}' <<<"$four" | median)
+drops=$(awk '{s += $3} END {print s}' <<<"$four")
+awk -v p="$pipeline" -v d="$duration" -v q="$p99" -v x="$drops" -v n="$runs" -v each="$(awk '{printf "%s ", $2}' <<<"$four")" \
+  'BEGIN {printf "four VLP-16 streams (dual return, merged), real time, %d runs: CPU of the pipeline %.3f s for %.1f s of data = %.2f %% of one core (median; goal <= 4 %%); latency last packet → LCM p99 %s ms (median; goal <= 2 ms; each run: %s); ring drops %d\n", n, p, d, 100 * p / d, q, each, x}'

@@ -110,24 +110,37 @@ ScanCalibration GridFilter<RoiSet>::calibrate() const {
   IndexVector kept;
   kept.reserve(cloud.size());
   const std::span<const PointXYZI> points(cloud);
-  double best = std::numeric_limits<double>::infinity();
-  for (const SimdPath path : {SimdPath::kAvx512, SimdPath::kAvx2, SimdPath::kSse2, SimdPath::kScalar}) {
-    if (!cpu_has(path)) continue;
-    double fastest = std::numeric_limits<double>::infinity();
-    for (int run = 0; run < 7; ++run) {
+  // The paths are timed in rounds, one run of each per round in a rotating order, each keeping
+  // its fastest: a slow spell of the machine (another process, a frequency change) then falls
+  // on every path alike instead of on whichever was being timed, and cannot make a narrower
+  // scan look faster than a wider one it only happened to follow.
+  std::vector<SimdPath> paths;
+  for (const SimdPath path : {SimdPath::kAvx512, SimdPath::kAvx2, SimdPath::kSse2, SimdPath::kScalar})
+    if (cpu_has(path)) paths.push_back(path);
+  std::vector<double> fastest(paths.size(), std::numeric_limits<double>::infinity());
+  std::vector<bool> out_of_it(paths.size(), false);
+  for (std::size_t round = 0; round < 7; ++round) {
+    for (std::size_t k = 0; k < paths.size(); ++k) {
+      const std::size_t i = (k + round) % paths.size();
+      if (out_of_it[i]) continue;
       const auto start = std::chrono::steady_clock::now();
-      (void)filter(points, kept, path);
+      (void)filter(points, kept, paths[i]);
       const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count();
-      fastest = std::min(fastest, ns / static_cast<double>(points.size()));
-      // Twice as slow as the best path so far even at its second run: it cannot win (start-up
-      // is part of a replay's time).
-      if (run >= 1 && fastest > 2.0 * best) break;
+      fastest[i] = std::min(fastest[i], ns / static_cast<double>(points.size()));
     }
-    result.ns_per_point[static_cast<int>(path)] = fastest;
+    // Twice as slow as the best path even at its second run: it cannot win (start-up is part
+    // of a replay's time).
+    const double best_so_far = *std::min_element(fastest.begin(), fastest.end());
+    for (std::size_t i = 0; i < paths.size() && round >= 1; ++i)
+      out_of_it[i] = out_of_it[i] || fastest[i] > 2.0 * best_so_far;
+  }
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    result.ns_per_point[static_cast<int>(paths[i])] = fastest[i];
     // A narrower scan must be clearly faster (3 %) to be chosen over a wider one.
-    if (fastest < best * 0.97) {
-      best = fastest;
-      result.chosen = path;
+    if (fastest[i] < best * 0.97) {
+      best = fastest[i];
+      result.chosen = paths[i];
     }
   }
   auto_path_.store(result.chosen, std::memory_order_relaxed);

@@ -78,8 +78,8 @@ bool matches_a_sweep(const trajroi::points_t& m, const trajroi::roi_t& roi, std:
       same = m.time_offset_ns[k] - shift == static_cast<std::int64_t>(p.time_offset_ns) && m.ring[k] == p.ring &&
              m.return_type[k] == static_cast<std::uint8_t>(p.return_type);
       // Placed by this sensor's mounting: within float rounding of the pose times the point.
-      const Eigen::Vector3d g = pose.isometry() * Eigen::Vector3d(p.x, p.y, p.z);
-      same = same && (g - Eigen::Vector3d(m.x[k], m.y[k], m.z[k])).norm() < 1e-3;
+      const Eigen::Vector3d g = pose.isometry() * Eigen::Vector3f(p.x, p.y, p.z).cast<double>();
+      same = same && (g - Eigen::Vector3f(m.x[k], m.y[k], m.z[k]).cast<double>()).norm() < 1e-3;
     }
     if (same) return true;
   }
