@@ -102,6 +102,16 @@ void add_inputs(Pipeline& pipeline, const DaemonConfig& config, const RunOptions
     udp.sensor_address = sharing == 1 ? l.sensor_address : std::string();
     udp.share_ports = l.share_ports;
     auto lidar = std::make_unique<inputs::UdpInput>(udp);
+    if (sharing > 1) {
+      std::string who;
+      for (const DaemonConfig::Lidar& other : lidars) {
+        if (other.data_port == l.data_port) who += (who.empty() ? "" : ", ") + other.name + " " + other.sensor_address;
+      }
+      log::info(
+          "lidars on UDP {}:{}/{} told apart by sender: {}; other senders' datagrams dropped "
+          "(lidar.rejected_source)",
+          l.bind_address, l.data_port, l.position_port, who);
+    }
     const std::string thread = lidars.size() == 1 ? "trajroid-lidar" : ("trajroid-l-" + l.name).substr(0, 15);
     pipeline.add_input(std::move(lidar), config.buffers.lidar_packets, thread, config.realtime.lidar);
   }
