@@ -62,6 +62,19 @@ def start_view(cli, url, port, log):
     return p
 
 
+def stop_all(browser, processes):
+    """Closes the browser and ends the processes, newest first (SIGINT, then SIGKILL after 10 s)."""
+    if browser:
+        browser.close()
+    for p in reversed(processes):
+        if p.poll() is None:
+            p.send_signal(signal.SIGINT)
+            try:
+                p.wait(10)
+            except subprocess.TimeoutExpired:
+                p.kill()
+
+
 def main():
     cli, trajroid, scenario, out = sys.argv[1:5]
     need("chromium", "chromium")
@@ -145,15 +158,7 @@ def main():
                  lambda: "no data from trajroid" in browser.text("connection"), 10)
         print("ok: the page says: " + browser.text("connection"))
     finally:
-        if browser:
-            browser.close()
-        for p in reversed(processes):
-            if p.poll() is None:
-                p.send_signal(signal.SIGINT)
-                try:
-                    p.wait(10)
-                except subprocess.TimeoutExpired:
-                    p.kill()
+        stop_all(browser, processes)
 
     # What trajroid published, as lcm-logger logged it.
     points, rois, raws, trajectories, statuses = {}, {}, {}, [], []

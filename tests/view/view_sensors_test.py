@@ -1,19 +1,20 @@
 """trajroi view colours the points of several LiDARs by sensor, in a real browser.
 
-A two-LiDAR run is made from real captures: the MRPT VLP-16 (strongest return, from
-10.0.0.100) and nebula's VLP-16 (dual return, from 192.168.1.201), on one port, each played
-twelve times over as a sensor running that long (each play's record times and VLP-16 clock moved
-on by the capture's length; the azimuth starts again at each play: a partial sweep there). trajroid replays it at real time with lidars: front and rear (told
-apart by address, mounted apart); `trajroi view` serves the page to Debian's headless chromium.
-The page must name the sensors in its legend, and with "colour by sensor" the pixels where it
-put each sensor's points must be that sensor's colour.
+Two real captures are sent live over UDP at their recorded pace by `trajroi feed`, to one port:
+the MRPT VLP-16 (strongest return) from 127.0.0.2 and nebula's VLP-16 (dual return) from
+127.0.0.3, each played twelve times over as a sensor running that long (each play's record
+times and VLP-16 clock moved on by the capture's length; the azimuth starts again at each play:
+a partial sweep there). trajroid runs live with lidars: front and rear (told apart by address,
+mounted apart); `trajroi view` serves the page to Debian's headless chromium; lcm-logger logs
+what trajroid published. The page must name the sensors in its legend, hold for the sweep it
+shows as many points of each sensor as the published points_t does, and with "colour by
+sensor" the pixels where it put each sensor's points must be that sensor's colour.
 
 Arguments: TRAJROI_CLI TRAJROID OUT_DIR (TRAJROI_DATA_DIR: the shared captures).
 Exit 0 pass, 1 fail, 77 skip."""
 
 import os
 import shutil
-import signal
 import struct
 import subprocess
 import sys
@@ -21,62 +22,38 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(HERE, "..", "..", "bench"))
 import png  # noqa: E402
 import webdriver  # noqa: E402
-from view_page_test import check, need, run_main, start_view, wait_for  # noqa: E402
+from four_lidars import records  # noqa: E402
+from view_page_test import check, need, run_main, start_view, stop_all, wait_for  # noqa: E402
 from view_rtk_test import data_file  # noqa: E402
 
 DATA_FRAME = 42 + 1206  # Ethernet + IPv4 + UDP + a VLP-16 data packet
 TOH = 42 + 1200  # the packet's timestamp (µs past the hour)
 
 
-def read_pcap(path):
-    """(time ns, frame) of each record of a classic little-endian pcap (µs or ns stamps)."""
-    data = open(path, "rb").read()
-    magic = struct.unpack("<I", data[:4])[0]
-    check(magic in (0xA1B2C3D4, 0xA1B23C4D), "%s: a little-endian pcap" % path)
-    scale = 1000 if magic == 0xA1B2C3D4 else 1
-    out, at = [], 24
-    while at + 16 <= len(data):
-        sec, frac, length, _ = struct.unpack("<IIII", data[at:at + 16])
-        out.append((sec * 1_000_000_000 + frac * scale, bytearray(data[at + 16:at + 16 + length])))
-        at += 16 + length
-    return out
-
-
-def played(records, plays, source, start_ns):
-    """The records played `plays` times as one sensor running longer, from `source`, the first at
-    `start_ns`; position packets in the first play only."""
-    data = [(t, f) for t, f in records if len(f) == DATA_FRAME]
-    tohs = [struct.unpack("<I", f[TOH:TOH + 4])[0] for _, f in data]
+def played(path, plays, out):
+    """The capture played `plays` times as one sensor running that much longer, written to `out`
+    (a nanosecond pcap); position packets in the first play only."""
+    original = list(records(path))
+    tohs = [struct.unpack("<I", f[TOH:TOH + 4])[0] for _, f in original if len(f) == DATA_FRAME]
     period_us = sorted(b - a for a, b in zip(tohs, tohs[1:]))[len(tohs) // 2]  # 1327 strongest, 664 dual
     length_us = tohs[-1] - tohs[0] + period_us
-    out = []
-    for play in range(plays):
-        for t, frame in records:
-            if play > 0 and len(frame) != DATA_FRAME:
-                continue
-            f = bytearray(frame)
-            f[26:30] = bytes(int(b) for b in source.split("."))
-            f[24:26] = b"\0\0"
-            words = struct.unpack(">10H", bytes(f[14:34]))
-            total = sum(words)
-            while total > 0xFFFF:
-                total = (total & 0xFFFF) + (total >> 16)
-            f[24:26] = struct.pack(">H", ~total & 0xFFFF)
-            if len(f) == DATA_FRAME:
-                toh = (struct.unpack("<I", f[TOH:TOH + 4])[0] + play * length_us) % 3_600_000_000
-                f[TOH:TOH + 4] = struct.pack("<I", toh)
-            out.append((start_ns + (t - records[0][0]) + play * length_us * 1000, f))
-    return out
-
-
-def write_pcap(path, records):
-    with open(path, "wb") as f:
+    with open(out, "wb") as f:
         f.write(struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, 1))
-        for t, frame in sorted(records, key=lambda r: r[0]):
-            f.write(struct.pack("<IIII", t // 1_000_000_000, t % 1_000_000_000, len(frame), len(frame)))
-            f.write(frame)
+        for play in range(plays):
+            for t, frame in original:
+                if play > 0 and len(frame) != DATA_FRAME:
+                    continue
+                frame = bytearray(frame)
+                if len(frame) == DATA_FRAME:
+                    toh = (struct.unpack("<I", frame[TOH:TOH + 4])[0] + play * length_us) % 3_600_000_000
+                    frame[TOH:TOH + 4] = struct.pack("<I", toh)
+                t += play * length_us * 1000
+                f.write(struct.pack("<IIII", t // 1_000_000_000, t % 1_000_000_000, len(frame), len(frame)))
+                f.write(frame)
+    return out
 
 
 CONFIG = """global_frame:
@@ -85,11 +62,15 @@ trajectory:
   file: trajectory.csv
 lidars:
   - name: front
-    sensor_address: 10.0.0.100
+    sensor_address: 127.0.0.2
+    data_port: %(data)d
+    position_port: %(position)d
     mounting: {xyz: [0.5, 0, 0.8]}
     min_range_m: 0.5
   - name: rear
-    sensor_address: 192.168.1.201
+    sensor_address: 127.0.0.3
+    data_port: %(data)d
+    position_port: %(position)d
     mounting: {xyz: [-0.5, 0, 0.8], yaw_deg: 180}
     min_range_m: 0.5
 pose:
@@ -106,36 +87,43 @@ def main():
     cli, trajroid, out = sys.argv[1:4]
     need("chromium", "chromium")
     need("chromedriver", "chromium-driver")
+    need("lcm-logger", "liblcm-bin")
     if not os.path.exists("/usr/share/javascript/three/three.min.js"):
         need("/nonexistent/three", "libjs-three")
+    import trajroi_lcm  # noqa: E402  (PYTHONPATH from ctest)
     strongest = data_file("velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap")
     dual = data_file("velodyne/vlp16/nebula_vlp16_dual_1673400471.DERIVED.pcap")
 
     work = os.path.join(out, "view_sensors_test")
     shutil.rmtree(work, ignore_errors=True)
-    run = os.path.join(work, "run")
-    os.makedirs(run)
-    start = 1_000_000_000_000
-    write_pcap(os.path.join(run, "lidar.pcap"),
-               played(read_pcap(strongest), 12, "10.0.0.100", start) +
-               played(read_pcap(dual), 12, "192.168.1.201", start))
-    with open(os.path.join(run, "trajectory.csv"), "w") as f:
+    os.makedirs(work)
+    front = played(strongest, 12, os.path.join(work, "front.pcap"))
+    rear = played(dual, 12, os.path.join(work, "rear.pcap"))
+    with open(os.path.join(work, "trajectory.csv"), "w") as f:
         f.write("x,y\n-30,0\n30,0\n")
-    with open(os.path.join(run, "trajroid.yaml"), "w") as f:
-        f.write(CONFIG)
+    data_port, position_port = webdriver.free_port(), webdriver.free_port()
+    with open(os.path.join(work, "trajroid.yaml"), "w") as f:
+        f.write(CONFIG % {"data": data_port, "position": position_port})
 
     lcm_port = webdriver.free_port()
     url = "udpm://239.255.76.67:%d?ttl=0&recv_buf_size=8388608" % lcm_port
+    log_path = os.path.join(work, "published.lcmlog")
     view_port = webdriver.free_port()
     view_log = open(os.path.join(work, "view.log"), "w")
     processes, browser = [], None
     try:
-        view = start_view(cli, url, view_port, view_log)
-        processes.append(view)
-        daemon = subprocess.Popen([trajroid, "--config", os.path.join(run, "trajroid.yaml"), "--replay", run,
-                                   "--rate", "1", "--lcm-url", url],
-                                  stdout=subprocess.DEVNULL, stderr=open(os.path.join(work, "trajroid.log"), "w"))
-        processes.append(daemon)
+        processes.append(subprocess.Popen(["lcm-logger", "--lcm-url=" + url, "-f", log_path],
+                                          stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT))
+        processes.append(start_view(cli, url, view_port, view_log))
+        daemon_log = os.path.join(work, "trajroid.log")
+        processes.append(subprocess.Popen([trajroid, "--config", os.path.join(work, "trajroid.yaml"), "--lcm-url", url],
+                                          stdout=subprocess.DEVNULL, stderr=open(daemon_log, "w")))
+        wait_for("trajroid to listen", lambda: "trajroid running" in open(daemon_log).read(), 10)
+        for pcap, address, name in ((front, "127.0.0.2", "front"), (rear, "127.0.0.3", "rear")):
+            processes.append(subprocess.Popen([cli, "feed", "--pcap", pcap, "--from", address, "--data-port",
+                                               str(data_port), "--position-port", str(position_port)],
+                                              stdout=subprocess.DEVNULL,
+                                              stderr=open(os.path.join(work, "feed_%s.log" % name), "w")))
         browser = webdriver.Browser()
         browser.open("http://127.0.0.1:%d/" % view_port)
         stats = lambda: browser.script("return window.trajroiStats;")  # noqa: E731
@@ -147,21 +135,28 @@ def main():
         browser.script("document.getElementById('colour-sensor').click();")
         browser.script("document.getElementById('pause').click();")
         time.sleep(0.5)
+        shown = stats()
         colours = browser.script("return window.trajroiSensorColours;")
         spots = browser.script("return window.trajroiProject(400);")
         shot = os.path.join(out, "view-sensors-screenshot.png")
         browser.screenshot(shot)
         print("page: legend '%s', %s" % (legend, browser.text("counters")))
+        time.sleep(0.5)  # the shown sweep is logged
     finally:
-        if browser:
-            browser.close()
-        for p in reversed(processes):
-            if p.poll() is None:
-                p.send_signal(signal.SIGINT)
-                try:
-                    p.wait(10)
-                except subprocess.TimeoutExpired:
-                    p.kill()
+        stop_all(browser, processes)
+
+    # The sweep the page shows, as trajroid published it: the same points of each sensor.
+    published = None
+    for channel, _, data in trajroi_lcm.read_log(log_path):
+        if channel == "TRAJROI_POINTS":
+            m = trajroi_lcm.decode(data)
+            if m.sweep_index == shown["lastSweep"]:
+                published = m
+    check(published is not None, "lcm-logger logged the shown sweep %s" % shown["lastSweep"])
+    check(list(published.sensor_names) == ["front", "rear"], "published sensors %s" % list(published.sensor_names))
+    counts = [sum(1 for s in published.sensor if s == k) for k in (0, 1)]
+    check(shown["sensorCounts"] == counts, "the page holds %s points of front and rear, the published sweep %s" % (
+        shown["sensorCounts"], counts))
 
     # Each sensor's points drawn in its colour, where the page put them (a point may lie under
     # the other sensor's: most, not all).

@@ -256,6 +256,9 @@
     }
     lastSweep = header;
     lastIntensity = { xyz: xyz, intensity: intensity, sensor: sensor };
+    var counts = (header.sensors || []).map(function () { return 0; });
+    for (var i = 0; i < sensor.length; ++i) if (sensor[i] < counts.length) ++counts[sensor[i]];
+    stats.sensorCounts = counts;  // the shown sweep's points of each sensor
     showSensors(header.sensors || []);
     kept.set(xyz, colours(xyz, intensity, robotZ, sensor));
     stats.roiShapes = drawRoi(header.roi, robotZ);
