@@ -128,7 +128,6 @@ void SweepMerger::emit(SweepSink& sink) {
     if ((merged_.sensors & (1U << i)) == 0 && silent(i, now_ns_)) merged_.silent |= 1U << i;
   }
   if (merged_.missing != 0) ++incomplete_;
-  ++merged_count_;
   sink.on_sweep(merged_);
   merged_.clear_points();
   merged_.sensors = 0;

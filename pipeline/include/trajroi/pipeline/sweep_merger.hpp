@@ -38,11 +38,8 @@ class SweepMerger {
   // True when sensor `sensor` has given no sweep for silent_s at `now_ns` (counted from the
   // first input for one that never did).
   [[nodiscard]] bool silent(std::size_t sensor, std::int64_t now_ns) const noexcept;
-  // Input time of its newest sweep (0: none yet).
-  [[nodiscard]] std::int64_t last_sweep_ns(std::size_t sensor) const noexcept { return last_ns_[sensor]; }
   // Sweeps that went out without a sensor that was waited for.
   [[nodiscard]] std::uint64_t incomplete() const noexcept { return incomplete_; }
-  [[nodiscard]] std::uint64_t merged() const noexcept { return merged_count_; }
   // Reserves and touches the merged sweep (Sweep::make_resident).
   void make_resident() { merged_.make_resident(); }
 
@@ -60,7 +57,7 @@ class SweepMerger {
   std::uint32_t waited_for_ = 0;  // the sensors not silent when the window opened
   std::vector<std::int64_t> last_ns_;
   std::uint64_t index_ = 0;
-  std::uint64_t incomplete_ = 0, merged_count_ = 0;
+  std::uint64_t incomplete_ = 0;
 };
 
 }  // namespace trajroi::pipeline

@@ -108,7 +108,6 @@ class SweepProcessor {
   // the input threads route with it to decode ahead.
   [[nodiscard]] std::size_t lane_count() const noexcept { return lanes_.size(); }
   [[nodiscard]] int lane_for(const inputs::InputItem& item) const noexcept;
-  [[nodiscard]] const DaemonConfig::Lidar& lane_lidar(std::size_t lane) const noexcept { return lanes_[lane]->lidar; }
   // The merge of several LiDARs' sweeps (null with one LiDAR).
   [[nodiscard]] const SweepMerger* merger() const noexcept { return merger_.get(); }
   // The input time of the newest item processed.
