@@ -47,7 +47,7 @@ bool cpu_has(SimdPath path) noexcept {
 #if defined(__x86_64__) || defined(__i386__)
   switch (path) {
     case SimdPath::kAvx512:
-      return __builtin_cpu_supports("avx512f");
+      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
     case SimdPath::kAvx2:
       return __builtin_cpu_supports("avx2");
     case SimdPath::kSse2:
@@ -330,7 +330,7 @@ FilterStats GridFilter<RoiSet>::filter(std::span<const Point> points, IndexVecto
 #if defined(__x86_64__) || defined(__i386__)
     if (path == SimdPath::kAuto) path = auto_path_.load(std::memory_order_relaxed);
     const bool wide = path == SimdPath::kAuto || path == SimdPath::kAvx512;
-    if (wide && __builtin_cpu_supports("avx512f")) {
+    if (wide && cpu_has(SimdPath::kAvx512)) {
       i = scan_avx512(points, scan);
     } else if ((wide || path == SimdPath::kAvx2) && __builtin_cpu_supports("avx2")) {
       i = scan_avx2(points, scan);

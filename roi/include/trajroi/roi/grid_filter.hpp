@@ -132,8 +132,8 @@ class GridFilter {
 #if defined(__x86_64__) || defined(__i386__)
   std::size_t scan_sse2(std::span<const PointXYZI> points, Scan& scan) const;
   __attribute__((target("avx2,popcnt"))) std::size_t scan_avx2(std::span<const PointXYZI> points, Scan& scan) const;
-  __attribute__((target("avx512f,popcnt"))) std::size_t scan_avx512(std::span<const PointXYZI> points,
-                                                                    Scan& scan) const;
+  __attribute__((target("avx512f,avx512dq,popcnt"))) std::size_t scan_avx512(std::span<const PointXYZI> points,
+                                                                             Scan& scan) const;
   // For the vector scans. The points first … first + n − 1 one by one, `count` indices
   // written so far; returns the new count. Never inlined nor cloned: the scans reach this
   // plain x86-64 code through a call of the standard ABI, before which the compiler clears
