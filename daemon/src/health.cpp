@@ -2,6 +2,7 @@
 
 #include <arpa/inet.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -31,6 +32,55 @@ std::uint64_t rejected_total(const StatusSnapshot& s) {
 // Data packets decoded (status lidar_packets counts the rejected ones too) and position packets.
 std::uint64_t accepted_packets(const StatusSnapshot& s) {
   return s.lidar_packets - rejected_total(s) + s.position_packets;
+}
+
+// The data ports the LiDARs are read on, each once: "port 2368" or "ports 2368, 2369".
+std::string data_ports(const DaemonConfig& config) {
+  std::vector<std::uint16_t> ports;
+  for (const DaemonConfig::Lidar& l : config.all_lidars())
+    if (std::find(ports.begin(), ports.end(), l.data_port) == ports.end()) ports.push_back(l.data_port);
+  std::string text = ports.size() == 1 ? "port " : "ports ";
+  for (std::size_t i = 0; i < ports.size(); ++i)
+    text += (i == 0 ? "" : ", ") + std::to_string(ports[i]);
+  return text;
+}
+
+// Where trajroid listens for LiDAR datagrams: "0.0.0.0:2368 (data) / 8308 (position)" for one
+// sensor; with several, each socket pair once with the sensors read on it:
+// "0.0.0.0:2368 / 8308 (front, rear), 0.0.0.0:2369 / 8309 (top)".
+std::string listening(const DaemonConfig& config) {
+  const std::vector<DaemonConfig::Lidar> lidars = config.all_lidars();
+  if (lidars.size() == 1) {
+    const DaemonConfig::Lidar& l = lidars.front();
+    return sprintf_text("%s:%u (data) / %u (position)", l.bind_address.c_str(), l.data_port, l.position_port);
+  }
+  std::string text;
+  for (std::size_t i = 0; i < lidars.size(); ++i) {
+    const DaemonConfig::Lidar& l = lidars[i];
+    const auto same_sockets = [&l](const DaemonConfig::Lidar& o) {
+      return o.bind_address == l.bind_address && o.data_port == l.data_port && o.position_port == l.position_port;
+    };
+    if (std::find_if(lidars.begin(), lidars.begin() + static_cast<std::ptrdiff_t>(i), same_sockets) !=
+        lidars.begin() + static_cast<std::ptrdiff_t>(i))
+      continue;  // said with the first sensor on these sockets
+    std::string names;
+    for (const DaemonConfig::Lidar& o : lidars)
+      if (same_sockets(o)) names += (names.empty() ? "" : ", ") + o.name;
+    text += (text.empty() ? "" : ", ") +
+            sprintf_text("%s:%u / %u (%s)", l.bind_address.c_str(), l.data_port, l.position_port, names.c_str());
+  }
+  return text;
+}
+
+// The senders accepted: "sensor_address 192.168.1.201", or with several LiDARs each one's:
+// "the sensor_address of front 127.0.0.2, rear 127.0.0.3" (a sensor without one takes any).
+std::string sensor_addresses(const DaemonConfig& config) {
+  const std::vector<DaemonConfig::Lidar> lidars = config.all_lidars();
+  if (lidars.size() == 1) return "sensor_address " + lidars.front().sensor_address;
+  std::string text;
+  for (const DaemonConfig::Lidar& l : lidars)
+    if (!l.sensor_address.empty()) text += (text.empty() ? "" : ", ") + l.name + " " + l.sensor_address;
+  return "the sensor_address of " + text;
 }
 
 }  // namespace
@@ -165,25 +215,27 @@ void HealthMonitor::lidar(const StatusSnapshot& s, std::vector<HealthLine>& out)
   const std::uint64_t not_vlp16 = delta(s, C::kLidarNotVlp16);
   const bool silent = live_ && judged(s) && accepted == 0 && foreign == 0 && not_vlp16 == 0 &&
                       delta(s, C::kLidarOversize) == 0 && rejected_total(s) == rejected_total(base);
+  // With several LiDARs these name every port and address (each silent sensor is also named
+  // on its own, by the merger's silent_s).
+  const std::string ports = data_ports(config_);
+  const std::string key = config_.lidars.size() > 1 ? "lidars[]" : "lidar";
   set(kLidarSilent, silent,
-      sprintf_text("lidar: no datagrams for %.0f s on UDP %s:%u (data) / %u (position): sensor off or unplugged, or "
-                   "sending to another port or address?",
-                   window, l.bind_address.c_str(), l.data_port, l.position_port),
-      sprintf_text("lidar: datagrams arriving on UDP port %u", l.data_port), out);
+      sprintf_text("lidar: no datagrams for %.0f s on UDP %s: sensor off or unplugged, or sending to another port or "
+                   "address?",
+                   window, listening(config_).c_str()),
+      sprintf_text("lidar: datagrams arriving on UDP %s", ports.c_str()), out);
   set(kLidarForeignOnly, live_ && accepted == 0 && foreign > 0,
-      sprintf_text(
-          "lidar: %llu datagrams in %.0f s on UDP port %u, none from sensor_address %s: is lidar.sensor_address "
-          "the sensor's?",
-          static_cast<unsigned long long>(foreign), window, l.data_port, l.sensor_address.c_str()),
+      sprintf_text("lidar: %llu datagrams in %.0f s on UDP %s, none from %s: is %s.sensor_address the sensor's?",
+                   static_cast<unsigned long long>(foreign), window, ports.c_str(), sensor_addresses(config_).c_str(),
+                   key.c_str()),
       "lidar: datagrams from the sensor_address arriving", out);
   set(kLidarNotVlp16Only, live_ && accepted == 0 && not_vlp16 > 0,
-      sprintf_text(
-          "lidar: %llu datagrams in %.0f s on UDP port %u and none a VLP-16 data packet (%u–%u bytes; a VLP-16 "
-          "sends 1206; %s): another device sends to this port (lidar.data_port), or the sensor's output is not "
-          "its factory packet format",
-          static_cast<unsigned long long>(not_vlp16), window, l.data_port, s.foreign_min_size, s.foreign_max_size,
-          sender_list(s).c_str()),
-      sprintf_text("lidar: VLP-16 packets arriving on UDP port %u", l.data_port), out);
+      sprintf_text("lidar: %llu datagrams in %.0f s on UDP %s and none a VLP-16 data packet (%u–%u bytes; a VLP-16 "
+                   "sends 1206; %s): another device sends to this port (%s.data_port), or the sensor's output is not "
+                   "its factory packet format",
+                   static_cast<unsigned long long>(not_vlp16), window, ports.c_str(), s.foreign_min_size,
+                   s.foreign_max_size, sender_list(s).c_str(), key.c_str()),
+      sprintf_text("lidar: VLP-16 packets arriving on UDP %s", ports.c_str()), out);
   // The model the packets are decoded as, said once (and again should it ever change).
   if (s.lidar_model >= 0 && s.lidar_model != lidar_model_said_) {
     const vlp16::ModelSpec& m = vlp16::spec(static_cast<vlp16::Model>(s.lidar_model));
@@ -224,11 +276,11 @@ void HealthMonitor::minute_summary(const StatusSnapshot& s, std::vector<HealthLi
   if (live_ && other > 0 && packets > 0) {
     out.push_back(
         {HealthLine::Level::kWarning,
-         sprintf_text("lidar: %llu datagrams in the last %.0f s on UDP port %u were not VLP-16 data packets, "
+         sprintf_text("lidar: %llu datagrams in the last %.0f s on UDP %s were not VLP-16 data packets, "
                       "beside %llu packets (%u–%u bytes; %s): another device sends to the sensor's port "
                       "(lidar.not_vlp16_datagrams %llu)",
                       static_cast<unsigned long long>(other),
-                      static_cast<double>(s.steady_ns - minute_start_.steady_ns) * 1e-9, config_.lidar.data_port,
+                      static_cast<double>(s.steady_ns - minute_start_.steady_ns) * 1e-9, data_ports(config_).c_str(),
                       static_cast<unsigned long long>(packets), s.foreign_min_size, s.foreign_max_size,
                       sender_list(s).c_str(), static_cast<unsigned long long>(s[C::kLidarNotVlp16]))});
   }
@@ -236,21 +288,21 @@ void HealthMonitor::minute_summary(const StatusSnapshot& s, std::vector<HealthLi
 }
 
 void HealthMonitor::update_state(const StatusSnapshot& s, const StatusSnapshot& previous) {
-  const DaemonConfig::Lidar& l = config_.lidar;
+  const std::string ports = data_ports(config_);
   std::string problems;
   const auto add = [&problems](const std::string& p) { problems += (problems.empty() ? "" : "; ") + p; };
   if (active_[kLidarNotVlp16Only]) {
-    add(sprintf_text("LiDAR: no VLP-16 packets on UDP port %u, only other datagrams", l.data_port));
+    add(sprintf_text("LiDAR: no VLP-16 packets on UDP %s, only other datagrams", ports.c_str()));
   } else if (active_[kLidarForeignOnly]) {
-    add(sprintf_text("LiDAR: datagrams on UDP port %u only from addresses other than sensor_address %s", l.data_port,
-                     l.sensor_address.c_str()));
+    add(sprintf_text("LiDAR: datagrams on UDP %s only from addresses other than %s", ports.c_str(),
+                     sensor_addresses(config_).c_str()));
   } else if (live_ && accepted_packets(s) == accepted_packets(history_.front()) &&
              rejected(s, vlp16::PacketError::kUnsupportedProduct) >
                  rejected(history_.front(), vlp16::PacketError::kUnsupportedProduct)) {
     const std::string reason = s.model_reason.data();
     add("LiDAR: packets rejected: " + (reason.empty() ? std::string("not a VLP-16") : reason));
   } else if (active_[kLidarSilent] || (live_ && accepted_packets(s) == 0)) {
-    add(sprintf_text("waiting for LiDAR data on UDP port %u", l.data_port));
+    add("waiting for LiDAR data on UDP " + ports);
   }
   if (s.silent_lidars != 0) add("LiDAR " + lidar_names(s.silent_lidars) + ": silent, not merged");
   bool pose_input_fault = false;

@@ -144,6 +144,43 @@ TEST(Health, NoLidarDatagramsAreNamedWithThePortWithinFiveSecondsAndTheirReturnT
             "waiting for LiDAR data on UDP port 2368; GNSS: no bytes from /dev/gnss; IMU: no bytes from /dev/imu");
 }
 
+// With several LiDARs the lines that say nothing (or nothing right) arrives name every
+// sensor's sockets and address, not the first sensor's alone.
+TEST(Health, WithSeveralLidarsNoDatagramsNameEverySensorsPortsAndAddresses) {
+  DaemonConfig c = live_config();
+  DaemonConfig::Lidar front = c.lidar;
+  front.name = "front";
+  front.sensor_address = "127.0.0.2";
+  DaemonConfig::Lidar rear = front;
+  rear.name = "rear";
+  rear.sensor_address = "127.0.0.3";
+  rear.data_port = 2369;
+  rear.position_port = 8309;
+  DaemonConfig::Lidar top = rear;
+  top.name = "top";
+  top.sensor_address = "127.0.0.4";
+  c.lidar = front;
+  c.lidars = {front, rear, top};
+  Said said = run(c, 6, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s.lidar_packets -= 754, s.position_packets -= 1;
+  });
+  EXPECT_GE(said.first("lidar: no datagrams for 3 s on UDP 0.0.0.0:2368 / 8308 (front), 0.0.0.0:2369 / 8309 (rear, "
+                       "top): sensor off"),
+            1)
+      << said.all();
+  EXPECT_EQ(said.state.rfind("waiting for LiDAR data on UDP ports 2368, 2369", 0), 0U) << said.state;
+  said = run(c, 6, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s.lidar_packets -= 754, s.position_packets -= 1;
+    s[Counter::kLidarRejectedSource] += 754;
+  });
+  EXPECT_GE(said.first("on UDP ports 2368, 2369, none from the sensor_address of front 127.0.0.2, rear 127.0.0.3, "
+                       "top 127.0.0.4: is lidars[].sensor_address the sensor's?"),
+            1)
+      << said.all();
+}
+
 TEST(Health, DatagramsOnlyFromAnotherSenderNameTheSensorAddress) {
   const Said said = run(live_config(), 6, [](StatusSnapshot& s, int) { s[Counter::kLidarRejectedSource] += 754; });
   const int at = said.first("none from sensor_address 192.168.1.201");
