@@ -188,6 +188,7 @@ TEST_P(MultiLidar, TwoLiveSendersMergeAsTrajroiFilterKeepsEachAndASilentOneIsNam
   std::vector<std::string> args = rig.daemon_args();
   args.insert(args.end(), {"--record", recording.string()});
   Child daemon(args, rig.daemon_log);
+  ASSERT_TRUE(wait_until_running(rig.daemon_log)) << rig.logs();
   // The rear's copies from 127.0.0.4, a sender that is no sensor's: dropped, counted.
   const auto feed = [&](const Sensor& s, const fs::path& pcap, const std::string& after, const std::string& log) {
     std::vector<std::string> a{"feed",

@@ -46,6 +46,7 @@ TEST_P(RealCaptures, SweepsArePublishedWithAValidPoseAndKeepWhatTrajroiFilterKee
   Listener listener(rig.prefix);
   ASSERT_TRUE(listener.good());
   Child daemon(rig.daemon_args(), rig.daemon_log);
+  ASSERT_TRUE(wait_until_running(rig.daemon_log)) << rig.logs();
 
   std::vector<std::string> feed = rig.pcap_feed(pcap, "3", {"--until", "5", "--linger", "2"});
   if (source == std::string("gnss_imu") || source == std::string("gnss")) {

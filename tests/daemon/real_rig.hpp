@@ -136,6 +136,14 @@ inline double seconds_until_logged(const fs::path& log, const std::string& text,
   return -1.0;
 }
 
+// Until trajroid says it runs (its sockets bound, its scans and decoder calibrated: it reads
+// from the next moment): a feed started before that can lose its first sweep to the start-up
+// (110 ms on a 2-core Zen 5 guest, where a 0.39 s capture then lost frame 0 and part of 1).
+inline bool wait_until_running(const fs::path& daemon_log) {
+  return seconds_until_logged(daemon_log, "trajroid running", std::chrono::steady_clock::now(), milliseconds(10000)) >=
+         0.0;
+}
+
 #define EXPECT_LOGGED_WITHIN_5S(rig, text, start)                                                    \
   do {                                                                                               \
     const double at_s = seconds_until_logged((rig).daemon_log, (text), (start), milliseconds(6000)); \

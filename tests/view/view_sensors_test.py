@@ -119,13 +119,14 @@ def main():
         processes.append(subprocess.Popen([trajroid, "--config", os.path.join(work, "trajroid.yaml"), "--lcm-url", url],
                                           stdout=subprocess.DEVNULL, stderr=open(daemon_log, "w")))
         wait_for("trajroid to listen", lambda: "trajroid running" in open(daemon_log).read(), 10)
+        # The page first: the feeds last about 5 s, less than a browser's start on a busy machine.
+        browser = webdriver.Browser()
+        browser.open("http://127.0.0.1:%d/" % view_port)
         for pcap, address, name in ((front, "127.0.0.2", "front"), (rear, "127.0.0.3", "rear")):
             processes.append(subprocess.Popen([cli, "feed", "--pcap", pcap, "--from", address, "--data-port",
                                                str(data_port), "--position-port", str(position_port)],
                                               stdout=subprocess.DEVNULL,
                                               stderr=open(os.path.join(work, "feed_%s.log" % name), "w")))
-        browser = webdriver.Browser()
-        browser.open("http://127.0.0.1:%d/" % view_port)
         stats = lambda: browser.script("return window.trajroiStats;")  # noqa: E731
         both = "var s = window.trajroiProject(400).map(function (p) { return p[2]; });" \
                "return s.indexOf(0) >= 0 && s.indexOf(1) >= 0;"
