@@ -96,8 +96,7 @@ TEST(LiveMessages, GarbageOnTheLidarPortIsNamedWithSizesAndSendersAndNotBlamedOn
   Listener listener(rig.prefix);
   ASSERT_TRUE(listener.good());
   Child daemon(rig.daemon_args(), rig.daemon_log);
-  ASSERT_GE(seconds_until_logged(rig.daemon_log, "trajroid running", std::chrono::steady_clock::now(), seconds(5)),
-            0.0);
+  ASSERT_TRUE(wait_until_running(rig.daemon_log)) << rig.logs();
   const auto start = std::chrono::steady_clock::now();
   std::thread sender([&] { send_garbage(rig.data_port, 2000); });
   EXPECT_LOGGED_WITHIN_5S(rig, "none a VLP-16 data packet (", start);

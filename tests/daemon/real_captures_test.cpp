@@ -317,8 +317,7 @@ TEST(LiveFaults, ARejectedTrajectoryMessageIsSaidAmidWithheldSweepWarnings) {
 TEST(LiveFaults, ASecondDaemonOnTheSameLidarPortFailsAtStartNamingThePort) {
   const Rig rig("exclusive", "fixed", 10);
   Child first(rig.daemon_args(), rig.daemon_log);
-  ASSERT_GE(seconds_until_logged(rig.daemon_log, "trajroid running", std::chrono::steady_clock::now(), seconds(5)), 0.0)
-      << rig.logs();
+  ASSERT_TRUE(wait_until_running(rig.daemon_log)) << rig.logs();
   const fs::path second_log = rig.dir / "second.log";
   Child second(rig.daemon_args(), second_log);
   const int code = second.wait(seconds(5));

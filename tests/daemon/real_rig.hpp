@@ -136,11 +136,12 @@ inline double seconds_until_logged(const fs::path& log, const std::string& text,
   return -1.0;
 }
 
-// Until trajroid says it runs (its sockets bound, its scans and decoder calibrated: it reads
-// from the next moment): a feed started before that can lose its first sweep to the start-up
-// (110 ms on a 2-core Zen 5 guest, where a 0.39 s capture then lost frame 0 and part of 1).
+// Whether trajroid says it runs within 5 s (its sockets bound, its scans and decoder
+// calibrated: it reads from the next moment). A feed started before that sends its first
+// datagrams to ports not yet bound: on a 2-core Zen 5 guest trajroid's start-up took 110 ms,
+// and a 0.39 s capture lost frame 0 and part of frame 1.
 inline bool wait_until_running(const fs::path& daemon_log) {
-  return seconds_until_logged(daemon_log, "trajroid running", std::chrono::steady_clock::now(), milliseconds(10000)) >=
+  return seconds_until_logged(daemon_log, "trajroid running", std::chrono::steady_clock::now(), milliseconds(5000)) >=
          0.0;
 }
 
