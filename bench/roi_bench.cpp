@@ -7,7 +7,8 @@
 // The fast filter runs the scan GridFilter::calibrate() found fastest on this machine for each
 // shape (as the daemon does at start); TRAJROI_SIMD=avx512|avx2|sse2|scalar forces one, to
 // compare them. The context printed first names the CPU, the cores and each shape's scan with
-// the calibration's times.
+// the calibration's times. probe/clock and probe/scan (the scan of one frame in the cache) measure
+// the core between the others: their ranges show a slow spell of the host during the run.
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
@@ -138,6 +139,26 @@ void limit_memcpy(benchmark::State& state, bool accumulated) {
   set_counters(state, points.size(), 0, 0);
 }
 
+// The fast filter's scan alone on one frame held in the cache, on a grid built once (rectangles,
+// 10 %): bound by the core, not by memory. Its range over a run shows whether the host slowed the
+// core's vector work meanwhile, which the integer clock (probe/clock) does not always show.
+constexpr int kProbePasses = 10;
+void probe_scan(benchmark::State& state) {
+  const auto& points = cloud(false);
+  const auto set = make_set<roi::RectangularRoiSet>(10);
+  roi::GridFilter<roi::RectangularRoiSet> grid;
+  grid.build(set);
+  roi::IndexVector kept;
+  kept.reserve(points.size());
+  for (auto _ : state) {
+    for (int pass = 0; pass < kProbePasses; ++pass) {
+      grid.filter(std::span<const roi::PointXYZI>(points), kept);
+      benchmark::DoNotOptimize(kept.data());
+    }
+  }
+  set_counters(state, points.size() * kProbePasses, kept.size() * kProbePasses, set.size());
+}
+
 // Calibrates the shape's scan on its 25 % chain (what the daemon does at start) and says the
 // choice in the benchmark's context.
 template <typename RoiSet>
@@ -152,6 +173,8 @@ int register_all() {
   check_simd_variable();
   calibrate<roi::CircularRoiSet>("circular");
   calibrate<roi::RectangularRoiSet>("rectangular");
+  register_core_clock();
+  with_range(benchmark::RegisterBenchmark("probe/scan", probe_scan))->Unit(benchmark::kMicrosecond);
   for (const bool accumulated : {false, true}) {
     const std::string where = accumulated ? "accumulated" : "frame";
     const auto unit = accumulated ? benchmark::kMillisecond : benchmark::kMicrosecond;

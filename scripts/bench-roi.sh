@@ -10,7 +10,8 @@ context=$(mktemp)
 trap 'rm -f "$out" "$context"' EXIT
 "$build/bench/roi_bench" --benchmark_min_time=0.5 --benchmark_repetitions=7 --benchmark_enable_random_interleaving=true \
   --benchmark_report_aggregates_only=true --benchmark_format=console 2>"$context" |
-  awk '/_median/ { name = $1; sub(/_median$/, "", name); t = $2; if ($3 == "us") t /= 1000; print name, t }' >"$out"
+  awk '/_median / { name = $1; sub(/_median$/, "", name); t = $2; if ($3 == "us") t /= 1000; print name, t }
+       /^probe\/[a-z]+_(min|max) / { t = $2; if ($3 == "us") t /= 1000; print $1, t }' >"$out"
 # Where the figures come from: the CPU and its cores, and the scan the calibration chose for
 # each shape (what the fast filter ran, unless TRAJROI_SIMD forced one).
 grep -E "^(machine|scan_circular|scan_rectangular):" "$context" || true
@@ -33,6 +34,23 @@ awk '
         name = "limit/" limits[l] "/" wheres[w]
         if (name in ms) printf "%-44s %12.4f\n", name, ms[name]
       }
+    }
+    # The core between the others: the clock (x86: 10 M dependent additions, one per cycle) and
+    # the scan of one frame in the cache (10 passes over 28 800 points), each as 7 samples.
+    if ("probe/scan" in ms) {
+      printf "\nthe core over the run (7 samples each, between the others):\n"
+      slowed = 0
+      if ("probe/clock" in ms) {
+        ghz = 10 / ms["probe/clock"]; low = 10 / ms["probe/clock_max"]; high = 10 / ms["probe/clock_min"]
+        printf "  clock %.2f GHz (median), %.2f–%.2f\n", ghz, low, high
+        slowed = slowed || low < 0.85 * ghz
+      }
+      ns = ms["probe/scan"] * 1e6 / 288000
+      printf "  fast scan in the cache %.2f ns per point (median), %.2f–%.2f\n", ns,
+        ms["probe/scan_min"] * 1e6 / 288000, ms["probe/scan_max"] * 1e6 / 288000
+      slowed = slowed || ms["probe/scan_max"] > 1.15 * ms["probe/scan"]
+      if (slowed)
+        printf "  the host slowed the core for part of the run: figures taken then are slower for the scans\n  (bound by the core), hardly for the memcpy (bound by memory); see docs/performance.md\n"
     }
     printf "\nGoals on the accumulated cloud (2.88 M points), same run:\n"
     fails = 0
