@@ -24,9 +24,9 @@ inline benchmark::internal::Benchmark* with_range(benchmark::internal::Benchmark
 
 #if defined(__x86_64__) || defined(__i386__)
 // A chain of kClockAdds dependent integer additions: one per cycle on every x86 core, so one
-// iteration takes kClockAdds / clock. A shared host can slow a guest's core for many seconds:
-// a figure taken in such a spell is slower for a compute-bound loop and hardly for a
-// memory-bound one (a memcpy), which a ratio of the two does not cancel.
+// iteration takes kClockAdds / clock. A shared host can slow a guest's core, often, for tenths
+// of a second: a figure taken in such a spell is slower for a compute-bound loop and hardly for
+// a memory-bound one (a memcpy), which a ratio of the two does not cancel.
 inline constexpr std::uint64_t kClockAdds = 10'000'000;
 inline void core_clock(benchmark::State& state) {
   std::uint64_t x = 0;
