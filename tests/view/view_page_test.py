@@ -143,7 +143,7 @@ def main():
         shown = stats()
         counters = browser.text("counters")
         raw_counters = browser.text("raw-counters")
-        panel = {k: browser.text(k) for k in ("pose", "corrections", "time")}
+        panel = browser.texts(("pose", "corrections", "time"))  # one status_t's, not two
         dom = browser.dom()
         with open(os.path.join(work, "page.html"), "w") as f:
             f.write(dom)

@@ -138,7 +138,7 @@ def main():
                  lambda: browser.text("corrections").startswith(streaming) and "RTK float" in browser.text("pose"),
                  30)
         time.sleep(2.5)  # past the first seconds' figures
-        panel = {k: browser.text(k) for k in ("pose", "corrections", "time")}
+        panel = browser.texts(("pose", "corrections", "time"))  # one status_t's, not two
         print("page: " + " | ".join(panel.values()))
         time.sleep(1.5)  # the status shown is logged before the logger stops
     finally:

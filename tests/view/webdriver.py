@@ -59,6 +59,13 @@ class Browser:
     def text(self, element_id):
         return self.script("return document.getElementById(arguments[0]).textContent;", element_id)
 
+    def texts(self, element_ids):
+        """The elements' texts read in one script, so in one turn of the page's event loop: no
+        message arriving meanwhile can make them describe different moments."""
+        values = self.script("return arguments[0].map(id => document.getElementById(id).textContent);",
+                             list(element_ids))
+        return dict(zip(element_ids, values))
+
     def dom(self):
         return self.script("return document.documentElement.outerHTML;")
 
