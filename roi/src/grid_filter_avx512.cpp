@@ -98,11 +98,22 @@ struct Avx512Reuse {
   __m512i value;
 };
 
+// The values of the block's cells: the previous block's where a lane's cell is the same. On a
+// LiDAR sweep most firings change no lane's cell, and of the others most change one (the
+// benchmarks' scene: none in 77 % of firings, one in 13 %); on a Zen 5 a gather costs about
+// as much as locating the sixteen cells (13 cycles a firing to locate them, 23 with the
+// gathers, 21 with a single changed lane read by one load), so one changed lane is loaded alone.
 __attribute__((target("avx512f"), always_inline)) inline __m512i avx512_values(__m512i cell, Avx512Reuse& reuse,
                                                                                const int* cells) {
   const __mmask16 changed = _mm512_cmpneq_epi32_mask(cell, reuse.cell);
   if (changed != 0) {
-    reuse.value = _mm512_mask_i32gather_epi32(reuse.value, changed, cell, cells, 4);
+    if ((changed & (changed - 1)) == 0) {
+      // The changed lane's cell, brought to lane 0.
+      const int index = _mm512_cvtsi512_si32(_mm512_maskz_compress_epi32(changed, cell));
+      reuse.value = _mm512_mask_set1_epi32(reuse.value, changed, cells[index]);
+    } else {
+      reuse.value = _mm512_mask_i32gather_epi32(reuse.value, changed, cell, cells, 4);
+    }
     reuse.cell = cell;
   }
   return reuse.value;

@@ -31,8 +31,7 @@ inline std::size_t GridFilter<RoiSet>::cell_index(float x, float y) const noexce
 }
 
 template <typename RoiSet>
-__attribute__((always_inline)) inline std::uint32_t GridFilter<RoiSet>::decide(std::uint32_t cell, double x,
-                                                                               double y) const noexcept {
+inline std::uint32_t GridFilter<RoiSet>::decide(std::uint32_t cell, double x, double y) const noexcept {
   if (cell < kFirstBoundary) return cell;  // kOutside = 0, kInside = 1
   // The sub-cell from the same float arithmetic that chose the cell: its integer part is
   // the cell, its fraction (exact in float) the position inside it.
@@ -46,8 +45,7 @@ __attribute__((always_inline)) inline std::uint32_t GridFilter<RoiSet>::decide(s
 }
 
 template <typename RoiSet>
-__attribute__((always_inline)) inline std::uint32_t GridFilter<RoiSet>::decide_sub(std::uint32_t sub, double x,
-                                                                                   double y) const noexcept {
+inline std::uint32_t GridFilter<RoiSet>::decide_sub(std::uint32_t sub, double x, double y) const noexcept {
   if (sub < kFirstBoundary) return sub;
   const std::uint32_t id = sub - kFirstBoundary;
   for (std::uint32_t k = sub_offsets_[id]; k < sub_offsets_[id + 1]; ++k) {

@@ -158,9 +158,14 @@ class GridFilter {
 #endif
 
   // 0/1: is the point (x, y) in a cell with this value kept? Tests candidates for boundary cells.
-  [[nodiscard]] std::uint32_t decide(std::uint32_t cell, double x, double y) const noexcept;
+  // Inlined into each scan (GCC takes always_inline from this declaration, not from the
+  // definition in grid_filter_scan.hpp): called out of line from a vector scan, every call
+  // spilled and reloaded the scan's vector registers around it.
+  [[nodiscard]] __attribute__((always_inline)) inline std::uint32_t decide(std::uint32_t cell, double x,
+                                                                           double y) const noexcept;
   // The same for the point's sub-cell value in a boundary cell.
-  [[nodiscard]] std::uint32_t decide_sub(std::uint32_t sub, double x, double y) const noexcept;
+  [[nodiscard]] __attribute__((always_inline)) inline std::uint32_t decide_sub(std::uint32_t sub, double x,
+                                                                               double y) const noexcept;
   // Index into cells_ of the cell holding (x, y); the sentinel when off the grid.
   [[nodiscard]] std::size_t cell_index(float x, float y) const noexcept;
 
