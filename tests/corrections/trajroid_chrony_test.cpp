@@ -90,9 +90,12 @@ TEST(TrajroidChrony, ChronydReadsTheGnssTimeTrajroidWrites) {
     const std::lock_guard lock(listener.mutex);
     const double host_minus_gnss = listener.statuses.back().host_minus_gnss_utc_s;
     EXPECT_GT(std::abs(host_minus_gnss), 86400.0);  // the log is from another day: not the host's own time
-    // trajroid's status maps each epoch at the least latency seen; chronyd has the raw receive
-    // times of a pseudo-terminal: the same within a few milliseconds.
-    EXPECT_NEAR(chrony_offset, -host_minus_gnss, 0.05) << said;
+    // trajroid's status maps each epoch at the least latency seen; chronyd averages the raw
+    // receive times of its last samples, which a shared host can delay by tens of milliseconds
+    // (trajroi machine has seen threads held off 15–50 ms; 55 ms apart under ASan once). The
+    // log's epochs are 1 s apart, so a wrong epoch, leap second or time zone is ≥ 1 s off:
+    // within a quarter of an epoch, the two agree on which instant each NAV-PVT is.
+    EXPECT_NEAR(chrony_offset, -host_minus_gnss, 0.25) << said;
     std::cout << std::fixed << std::setprecision(4) << "chronyd: system clock wrong by " << chrony_offset
               << " s; trajroid: host − GNSS UTC " << host_minus_gnss << " s\n";
   }
