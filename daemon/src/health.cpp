@@ -128,6 +128,7 @@ std::vector<HealthLine> HealthMonitor::update(const StatusSnapshot& s) {
   serial_ports(s, out);
   localization(s, out);
   minute_summary(s, out);
+  rings(s, out);
 
   // The trajectory: nothing near the robot to keep.
   const double far_m = std::max(50.0, config_.roi.look_ahead_m);

@@ -58,6 +58,7 @@ class HealthMonitor {
     kClockOffset,
     kLidarClockOffset,
     kLidarPpsLost,
+    kRingDrops,
     kFaultCount
   };
   // Raises or clears `fault`: true → the warning (once, as it starts); false → the info line
@@ -68,6 +69,8 @@ class HealthMonitor {
   void serial_ports(const StatusSnapshot& s, std::vector<HealthLine>& out);
   void localization(const StatusSnapshot& s, std::vector<HealthLine>& out);
   void minute_summary(const StatusSnapshot& s, std::vector<HealthLine>& out);
+  // The rings between the threads: a drop named with its ring (health_rings.cpp).
+  void rings(const StatusSnapshot& s, std::vector<HealthLine>& out);
   // Several LiDARs: each one that falls silent or sends again, said.
   void lidar_sensors(std::uint32_t silent, std::vector<HealthLine>& out);
   [[nodiscard]] std::string lidar_names(std::uint32_t mask) const;

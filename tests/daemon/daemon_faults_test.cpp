@@ -288,6 +288,10 @@ TEST(TrajroidFaults, UdpFloodWithMalformedPacketsIsCountedBoundedAndRecoveredFro
   EXPECT_GE(last.decode_errors + oversize, malformed - lost);
   EXPECT_LE(counter(last, "lidar.duplicates"), flood - malformed);
   EXPECT_GE(counter(last, "lidar.duplicates"), flood - malformed - lost);
+  // A ring that dropped is named in the log with what fell behind.
+  if (ring > 0) {
+    EXPECT_NE(slurp(rig.daemon_log).find("dropped in the last second: lidar "), std::string::npos) << rig.logs();
+  }
   std::printf(
       "flood: %lld datagrams (%lld malformed) beside %lld data packets; kernel drops %lld, ring drops %lld; "
       "RSS %ld kB before, %ld kB peak\n",

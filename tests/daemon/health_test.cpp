@@ -444,3 +444,24 @@ TEST(Health, DatagramsThatAreNotVlp16PacketsAreNamedWithSizesAndSenders) {
 }
 
 }  // namespace
+
+// A ring that drops is named with what fell behind and the key that sizes it, as the drops
+// start (not every second while they go on), and the end once the window has none.
+TEST(Health, RingDropsAreNamedByRingWithTheThreadBehindAndTheirEnd) {
+  const Said said = run(live_config(), 12, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    if (t == 3) s[Counter::kRingDropsSweeps] += 5;
+    if (t == 4) s[Counter::kRingDropsSweeps] += 2, s[Counter::kRingDropsLidar] += 40;
+    if (t == 10) s[Counter::kRingDropsRecord] += 1;
+  });
+  EXPECT_EQ(said.first("rings: 5 items dropped in the last second: sweeps 5 (the publisher fell behind the processing "
+                       "thread; buffers.sweeps): is the CPU overloaded"),
+            3)
+      << said.all();
+  EXPECT_EQ(said.first("items dropped in the last second: lidar"), -1) << "said once as the drops start\n"
+                                                                       << said.all();
+  EXPECT_EQ(said.first("rings: no drops for 3 s (ring_drops.lidar 40, ring_drops.sweeps 7 in all)"), 7) << said.all();
+  EXPECT_EQ(said.first("rings: 1 item dropped in the last second: record 1 (the recorder fell behind"), 10)
+      << said.all();
+  EXPECT_EQ(said.state, "publishing 10.0 sweeps/s");
+}
