@@ -443,8 +443,6 @@ TEST(Health, DatagramsThatAreNotVlp16PacketsAreNamedWithSizesAndSenders) {
   EXPECT_EQ(said.lines.size(), 1U) << said.all();
 }
 
-}  // namespace
-
 // A ring that drops is named with what fell behind and the key that sizes it, as the drops
 // start (not every second while they go on), and the end once the window has none.
 TEST(Health, RingDropsAreNamedByRingWithTheThreadBehindAndTheirEnd) {
@@ -465,3 +463,5 @@ TEST(Health, RingDropsAreNamedByRingWithTheThreadBehindAndTheirEnd) {
       << said.all();
   EXPECT_EQ(said.state, "publishing 10.0 sweeps/s");
 }
+
+}  // namespace
