@@ -43,8 +43,8 @@ std::string_view counter_name(std::size_t index) noexcept {
 
 std::uint64_t StatusSnapshot::ring_drops() const noexcept {
   std::uint64_t drops = 0;
-  for (std::size_t c = at(C::kRingDropsLidar); c <= at(C::kRingDropsRecord); ++c)
-    drops += counters[c];
+  for (const Counter c : kRingDropCounters)
+    drops += (*this)[c];
   return drops;
 }
 

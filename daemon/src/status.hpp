@@ -98,6 +98,14 @@ inline constexpr std::size_t kCounterCount = static_cast<std::size_t>(Counter::k
 
 // The counter's name in the status message.
 [[nodiscard]] std::string_view counter_name(std::size_t index) noexcept;
+[[nodiscard]] inline std::string_view counter_name(Counter c) noexcept {
+  return counter_name(static_cast<std::size_t>(c));
+}
+
+// The drops of every ring between the threads ("ring_drops.*"), in the table's order.
+inline constexpr Counter kRingDropCounters[] = {
+    Counter::kRingDropsLidar,  Counter::kRingDropsGnss,   Counter::kRingDropsImu,        Counter::kRingDropsPose,
+    Counter::kRingDropsSweeps, Counter::kRingDropsStatus, Counter::kRingDropsTrajectory, Counter::kRingDropsRecord};
 
 struct StatusSnapshot {
   std::int64_t steady_ns = 0;
