@@ -464,4 +464,20 @@ TEST(Health, RingDropsAreNamedByRingWithTheThreadBehindAndTheirEnd) {
   EXPECT_EQ(said.state, "publishing 10.0 sweeps/s");
 }
 
+// The status total is every ring's drops, the localization input's too (its counter sits apart
+// from the others in the table), and nothing else.
+TEST(Health, TheRingDropTotalCountsEveryRingAndNothingElse) {
+  StatusSnapshot s;
+  for (std::size_t c = 0; c < kCounterCount; ++c)
+    s.counters[c] = 1000;
+  std::uint64_t expected = 0;
+  for (std::size_t c = 0; c < kCounterCount; ++c) {
+    if (!counter_name(c).starts_with("ring_drops.")) continue;
+    s.counters[c] = c + 1;  // each ring its own count, none 1000
+    expected += c + 1;
+  }
+  EXPECT_EQ(s[Counter::kRingDropsPose], static_cast<std::size_t>(Counter::kRingDropsPose) + 1);
+  EXPECT_EQ(s.ring_drops(), expected);
+}
+
 }  // namespace
