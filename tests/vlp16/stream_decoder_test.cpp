@@ -405,5 +405,62 @@ TEST(Vlp16Stream, ASensorClockJumpIsCountedAsSuchNotAsLostPackets) {
   EXPECT_EQ(lost.counters.lost_packets, 3u);
 }
 
+// Feeds `count` packets of `sensor`, each received `delay_ns(i)` after it was sent (the
+// sensor's own clock running `ppm` slow against the host's), and answers the frames.
+std::vector<Frame> received_late(std::size_t count, const std::function<std::int64_t(std::size_t)>& delay_ns,
+                                 double ppm = 0.0) {
+  Sensor sensor;
+  Collector sink;
+  StreamDecoder decoder(Calibration::vlp16_default(), {});
+  const std::int64_t t0 = sensor.received();
+  for (std::size_t i = 0; i < count; ++i) {
+    auto p = sensor.next();
+    const auto sent = static_cast<double>(sensor.received() - t0) * (1.0 + ppm * 1e-6);
+    decoder.on_data_packet(p, t0 + std::llround(sent) + delay_ns(i), sink);
+  }
+  decoder.flush(sink);
+  EXPECT_EQ(decoder.counters().clock_resets, 0u);
+  return sink.frames;
+}
+
+// Receive delays only ever add latency, so the sweeps are timed by the least of them: a first
+// packet that waited 30 ms in a busy host's socket (and jitter of up to 2 ms on the others)
+// costs the first sweep its time, not every sweep after it (each was 30 ms late before).
+TEST(Vlp16Stream, ALateFirstPacketDoesNotMakeEverySweepLate) {
+  const auto on_time = received_late(6 * kPacketsPerTurn, [](std::size_t) { return 0; });
+  const auto late = received_late(6 * kPacketsPerTurn, [](std::size_t i) -> std::int64_t {
+    if (i == 0) return 30'000'000;
+    return i % 7 == 0 ? 0 : static_cast<std::int64_t>((i * 7919) % 2'000'000);
+  });
+  ASSERT_EQ(late.size(), on_time.size());
+  ASSERT_GE(on_time.size(), 6u);
+  EXPECT_NEAR(static_cast<double>(late[0].start_time_ns - on_time[0].start_time_ns), 30e6, 1e3);
+  for (std::size_t k = 1; k < late.size(); ++k) {
+    EXPECT_NEAR(static_cast<double>(late[k].start_time_ns - on_time[k].start_time_ns), 0.0, 1e3) << "sweep " << k;
+    EXPECT_EQ(late[k].points.size(), on_time[k].points.size());
+    EXPECT_EQ(late[k].end_time_ns - late[k].start_time_ns, on_time[k].end_time_ns - on_time[k].start_time_ns);
+  }
+}
+
+// A sensor clock running 100 ppm slow drifts 2.5 ms from the host's in 25 s: the anchor
+// follows it a window or two behind (5 s, 0.5 ms of drift each) instead of holding the first
+// packet's offset (2.5 ms off at the end).
+TEST(Vlp16Stream, TheAnchorFollowsASlowSensorClock) {
+  constexpr std::size_t kPackets = 25 * 10 * kPacketsPerTurn;  // 25 s at 10 Hz
+  const auto frames = received_late(kPackets, [](std::size_t i) { return static_cast<std::int64_t>(i % 5) * 100'000; },
+                                    100.0);
+  const auto on_time = received_late(kPackets, [](std::size_t) { return 0; });
+  ASSERT_EQ(frames.size(), on_time.size());
+  double worst_ms = 0.0;
+  for (std::size_t k = 1; k < frames.size(); ++k) {
+    // Where the host's clock has the sweep's first firing: 100 ppm later than the sensor says.
+    const auto since = static_cast<double>(on_time[k].start_time_ns - on_time[0].start_time_ns);
+    const double truth = static_cast<double>(on_time[0].start_time_ns) + since * (1.0 + 100e-6);
+    worst_ms = std::max(worst_ms, std::abs(static_cast<double>(frames[k].start_time_ns) - truth) / 1e6);
+  }
+  EXPECT_LT(worst_ms, 1.1);
+  EXPECT_GT(worst_ms, 0.4);  // the drift is real: the anchor moves in steps
+}
+
 }  // namespace
 }  // namespace trajroi::vlp16

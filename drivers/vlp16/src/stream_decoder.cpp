@@ -97,18 +97,35 @@ StreamDecoder::StreamDecoder(const Calibration& calibration, StreamOptions optio
 std::int64_t StreamDecoder::packet_time_ns(std::uint32_t toh_us, std::int64_t receive_time_ns, double period_us) {
   // The packet leaves the sensor after its last firing: its first one was a period earlier.
   const std::int64_t by_receive = receive_time_ns - std::llround(period_us * 1000.0);
-  if (!have_last_) {
-    anchor_time_ns_ = by_receive;
-    unwrapped_toh_us_ = 0;
-    return by_receive;
+  if (have_last_) {
+    unwrapped_toh_us_ += toh_delta_us(last_toh_us_, toh_us);
+    const std::int64_t by_sensor = anchor_time_ns_ + unwrapped_toh_us_ * 1000;
+    if (std::llabs(by_sensor - by_receive) <= kClockResetThreshold_ns) {
+      latency_min_ns_ = std::min(latency_min_ns_, by_receive - by_sensor);
+      return by_sensor;
+    }
+    ++counters_.clock_resets;
   }
-  unwrapped_toh_us_ += toh_delta_us(last_toh_us_, toh_us);
-  const std::int64_t by_sensor = anchor_time_ns_ + unwrapped_toh_us_ * 1000;
-  if (std::llabs(by_sensor - by_receive) <= kClockResetThreshold_ns) return by_sensor;
-  ++counters_.clock_resets;
   anchor_time_ns_ = by_receive;
   unwrapped_toh_us_ = 0;
+  latency_min_ns_ = kNoLatency;
+  window_start_ns_ = receive_time_ns;
   return by_receive;
+}
+
+std::int64_t StreamDecoder::settle_anchor(std::int64_t receive_time_ns) noexcept {
+  std::int64_t shift = 0;
+  if (latency_min_ns_ < 0) {
+    shift = latency_min_ns_;  // a packet came earlier than the anchor foretold
+  } else if (receive_time_ns - window_start_ns_ >= kClockWindow_ns) {
+    shift = latency_min_ns_ == kNoLatency ? 0 : latency_min_ns_;  // every one came later
+  } else {
+    return 0;
+  }
+  anchor_time_ns_ += shift;
+  latency_min_ns_ = kNoLatency;
+  window_start_ns_ = receive_time_ns;
+  return shift;
 }
 
 void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t receive_time_ns, FrameSink& sink,
@@ -161,7 +178,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
       if (observed_cdeg > kLossFactor * expected_cdeg) lost = missing(observed_cdeg, expected_cdeg);
     }
   }
-  const std::int64_t time_ns = packet_time_ns(toh, receive_time_ns, period_us);
+  std::int64_t time_ns = packet_time_ns(toh, receive_time_ns, period_us);
   const std::optional<std::int64_t> utc_ns = utc_clock_.to_utc_ns(toh);
 
   if (lost > 0) {
@@ -231,7 +248,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
       if (i == n) break;
     }
     const double phase = phase_deg(points[i].azimuth_deg, options_.cut_azimuth_deg);
-    const std::int64_t t = time_ns + points[i].time_offset_ns;
+    std::int64_t t = time_ns + points[i].time_offset_ns;
     const bool cut = have_phase && phase < last_phase_deg - 180.0;
     if (cut || (i > 0 && t - frame_.start_time_ns > kMaxFrameDuration_ns)) {
       carried_.assign(points.begin() + static_cast<std::ptrdiff_t>(i), points.end());
@@ -245,6 +262,9 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
     have_phase = true;
     Point& point = points[i];
     if (i == 0) {
+      const std::int64_t shift = settle_anchor(receive_time_ns);
+      time_ns += shift;
+      t += shift;
       frame_.start_time_ns = t;
       end_time_ns = t;
       frame_.start_utc_ns = utc_ns ? std::optional(*utc_ns + point.time_offset_ns) : std::nullopt;

@@ -7,8 +7,13 @@
 // Time. Every frame is stamped in the receive clock: the first packet anchors the sensor's
 // top-of-hour timestamps to its receive time (less the packet's own duration, since it is
 // sent after its last firing), and later packets are spaced by their sensor timestamps, so
-// receive jitter does not reach the points. The anchor is reset (and counted) when the two
-// clocks part by more than kClockResetThreshold_ns. When position packets carry a valid RMC
+// receive jitter does not reach the points. The anchor follows the least latency seen, as
+// receive delays only ever add to it: a packet received earlier than the anchor foretells
+// moves it earlier (a first packet that waited in a busy host's socket does not make every
+// later sweep late), and when every packet of kClockWindow_ns came later, it moves later by
+// the least of those delays (a sensor clock running slow). It moves only where a frame
+// starts, so a frame's points share one anchor. The anchor is reset (and counted) when the
+// two clocks part by more than kClockResetThreshold_ns. When position packets carry a valid RMC
 // with the PPS locked, frames also carry their start in UTC.
 //
 // Sequence. A timestamp step beyond 1.5 × the packet period (1327.1 µs single, 663.6 µs
@@ -25,6 +30,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -40,6 +46,8 @@ namespace trajroi::vlp16 {
 
 inline constexpr std::int64_t kClockResetThreshold_ns = 100'000'000;
 inline constexpr std::int64_t kRestartThreshold_us = 1'000'000;
+// The window over which the least receive latency is taken to follow a slow sensor clock.
+inline constexpr std::int64_t kClockWindow_ns = 5'000'000'000;
 // A frame is cut after this long even without an azimuth wrap (a stalled motor): ten times
 // the slowest sweep (5 Hz).
 inline constexpr std::int64_t kMaxFrameDuration_ns = 2'000'000'000;
@@ -186,6 +194,9 @@ class StreamDecoder {
   void append_late(std::span<const std::uint8_t> packet, std::int64_t packet_time_ns, FrameSink& sink,
                    const DecodedPacket* decoded);
   std::int64_t packet_time_ns(std::uint32_t toh_us, std::int64_t receive_time_ns, double period_us);
+  // Where a frame starts: moves the anchor to the least latency seen (see Time above) and
+  // answers by how much (to add to the packet's time).
+  std::int64_t settle_anchor(std::int64_t receive_time_ns) noexcept;
   void finish_frame(FrameSink& sink, bool partial);
   void report_points(FrameSink& sink);
 
@@ -212,6 +223,10 @@ class StreamDecoder {
   double rate_cdeg_per_us_ = 0.0;  // measured inside the last packet
   std::int64_t anchor_time_ns_ = 0;
   std::int64_t unwrapped_toh_us_ = 0;  // last packet's timestamp, unwrapped from the anchor
+  // The least of (receive − anchored sensor time) since window_start_ns_, or kNoLatency.
+  static constexpr std::int64_t kNoLatency = std::numeric_limits<std::int64_t>::max();
+  std::int64_t latency_min_ns_ = kNoLatency;
+  std::int64_t window_start_ns_ = 0;
   double last_phase_deg_ = 0.0;        // of the last point placed, from the cut azimuth
   bool have_phase_ = false;
 
