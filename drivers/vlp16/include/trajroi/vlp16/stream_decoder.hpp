@@ -227,7 +227,7 @@ class StreamDecoder {
   static constexpr std::int64_t kNoLatency = std::numeric_limits<std::int64_t>::max();
   std::int64_t latency_min_ns_ = kNoLatency;
   std::int64_t window_start_ns_ = 0;
-  double last_phase_deg_ = 0.0;        // of the last point placed, from the cut azimuth
+  double last_phase_deg_ = 0.0;  // of the last point placed, from the cut azimuth
   bool have_phase_ = false;
 
   Frame frame_;
