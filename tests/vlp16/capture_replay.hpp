@@ -35,7 +35,7 @@ struct Replay {
 // `ahead`: every data packet that validates is also decoded by it first and handed over with
 // its points (as trajroid's input threads decode ahead of the stream).
 inline Replay replay(const std::filesystem::path& path, const Calibration& calibration = Calibration::vlp16_default(),
-              StreamOptions options = {}, const PacketDecoder* ahead = nullptr) {
+                     StreamOptions options = {}, const PacketDecoder* ahead = nullptr) {
   Replay r;
   DecodedPacket decoded;
   PcapSource source(path);

@@ -1,6 +1,8 @@
 // The pcap source on its own: real captures of ../shared/data cut, filtered and truncated while
 // read, every link type it reads, and captures read in place agreeing with libpcap's reading of
 // the same bytes datagram for datagram.
+#include "trajroi/vlp16/pcap_source.hpp"
+
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -16,7 +18,6 @@
 
 #include "test_data.hpp"
 #include "trajroi/vlp16/packet.hpp"
-#include "trajroi/vlp16/pcap_source.hpp"
 
 namespace trajroi::vlp16 {
 namespace {

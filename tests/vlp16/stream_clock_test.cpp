@@ -15,11 +15,11 @@
 namespace trajroi::vlp16 {
 namespace {
 
+using model_test::Collector;
 using stream_test::kPacketsPerTurn;
 using stream_test::Outcome;
 using stream_test::run;
 using stream_test::Sensor;
-using model_test::Collector;
 
 TEST(Vlp16Stream, TopOfHourWrapIsNotALossNorAClockReset) {
   Sensor sensor;
@@ -151,8 +151,8 @@ TEST(Vlp16Stream, ALateFirstPacketDoesNotMakeEverySweepLate) {
 // packet's offset (2.5 ms off at the end).
 TEST(Vlp16Stream, TheAnchorFollowsASlowSensorClock) {
   constexpr std::size_t kPackets = 25 * 10 * kPacketsPerTurn;  // 25 s at 10 Hz
-  const auto frames = received_late(kPackets, [](std::size_t i) { return static_cast<std::int64_t>(i % 5) * 100'000; },
-                                    100.0);
+  const auto frames = received_late(
+      kPackets, [](std::size_t i) { return static_cast<std::int64_t>(i % 5) * 100'000; }, 100.0);
   const auto on_time = received_late(kPackets, [](std::size_t) { return 0; });
   ASSERT_EQ(frames.size(), on_time.size());
   double worst_ms = 0.0;

@@ -51,7 +51,7 @@ struct Outcome {
   std::string rejection;
 };
 inline Outcome run(Sensor sensor, std::size_t count, StreamOptions options = {},
-            const std::function<bool(std::size_t, std::vector<std::uint8_t>&)>& edit = {}) {
+                   const std::function<bool(std::size_t, std::vector<std::uint8_t>&)>& edit = {}) {
   Outcome r;
   StreamDecoder decoder(Calibration::vlp16_default(), options);
   for (std::size_t i = 0; i < count; ++i) {
