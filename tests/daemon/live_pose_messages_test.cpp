@@ -161,6 +161,9 @@ TEST(LivePoseMessages, ALocalizationFromPythonIsUsedAndItsStopReturnAndInvalidPo
   Listener listener(rig.prefix);
   Child daemon(rig.daemon_args(), rig.daemon_log);
   Child lidar(TRAJROI_CLI, corridor_lidar(rig, "24"), rig.feed_log);
+  // The planner publishes its trajectory once, as it starts: only after the daemon listens (it
+  // subscribes before its first status; a sanitizer's slow start-up once lost the message).
+  ASSERT_TRUE(listener.wait_for([&] { return !listener.statuses.empty(); }, seconds(20))) << rig.logs();
   // Parked on the trajectory, facing north; the planner's trajectory (id 5) first.
   {
     Child python =
