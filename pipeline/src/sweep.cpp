@@ -1,19 +1,15 @@
 #include "trajroi/pipeline/sweep.hpp"
 
+#include "trajroi/host/memory.hpp"
 #include "trajroi/roi/transform.hpp"
 
 namespace trajroi::pipeline {
 namespace {
 
-// Writes one element in every page of an empty array's capacity, so that its memory is
-// resident (see Sweep::make_resident).
+// Makes an array's whole capacity resident (see Sweep::make_resident).
 template <typename Array>
 void touch_capacity(Array& a) {
-  a.resize(a.capacity());  // default-initialised: nothing written yet
-  constexpr std::size_t kStride = 4096 / sizeof(typename Array::value_type);
-  for (std::size_t i = 0; i < a.size(); i += kStride)
-    a[i] = typename Array::value_type{};
-  a.clear();
+  host::populate(a.data(), a.capacity() * sizeof(typename Array::value_type));
 }
 
 }  // namespace

@@ -12,6 +12,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "trajroi/host/memory.hpp"
+
 namespace trajroi::vlp16 {
 namespace {
 
@@ -80,7 +82,8 @@ struct PacketDecoder::StepTables {
 
 const PacketDecoder::AzimuthTable& PacketDecoder::azimuth_table() {
   static const std::unique_ptr<const AzimuthTable> table = [] {
-    auto t = std::make_unique<AzimuthTable>();
+    auto t = std::make_unique_for_overwrite<AzimuthTable>();  // every entry written below
+    host::populate(t.get(), sizeof(AzimuthTable));
     for (std::uint32_t a = 0; a < kAzimuthLimit; ++a) {
       const double rad = static_cast<double>(a) * kCentidegToRad;
       t->azimuth[a] = {std::cos(rad), std::sin(rad)};
@@ -92,7 +95,8 @@ const PacketDecoder::AzimuthTable& PacketDecoder::azimuth_table() {
 
 const PacketDecoder::StepTables& PacketDecoder::step_tables(Model model) {
   const auto build = [](Model m) {
-    auto t = std::make_unique<StepTables>();
+    auto t = std::make_unique_for_overwrite<StepTables>();  // every entry written below
+    host::populate(t.get(), sizeof(StepTables));
     const ModelSpec& s = spec(m);
     for (std::uint32_t gap = 0; gap <= kSeriesGapLimit_cdeg; ++gap) {
       const double gap_rad = static_cast<double>(gap) * kCentidegToRad;

@@ -2,9 +2,6 @@
 
 #include <fcntl.h>
 #include <pcap/pcap.h>
-#include <setjmp.h>
-#include <signal.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -15,6 +12,8 @@
 #include <stdexcept>
 #include <utility>
 #include <vector>
+
+#include "trajroi/host/memory.hpp"
 
 namespace trajroi::vlp16 {
 namespace {
@@ -65,48 +64,22 @@ long ipv4_offset(int link, const std::uint8_t* frame, std::size_t length) {
 
 }  // namespace
 
-// A mapped file that another process truncates while it is read: a read of a page past its new
-// end raises SIGBUS, which would end the daemon. The records are copied out of the mapping under
-// this guard: a SIGBUS in a guarded copy of this thread jumps back to it, which reports a read
-// error; any other SIGBUS takes the action it had before (the handler puts it back and the
-// faulting instruction runs again).
-namespace {
-namespace bus_guard {
-
-thread_local sigjmp_buf* active = nullptr;
-struct sigaction previous {};
-
-void on_sigbus(int signal, siginfo_t* info, void* context) {
-  (void)info;
-  (void)context;
-  if (active != nullptr) siglongjmp(*active, 1);
-  (void)sigaction(signal, &previous, nullptr);
-}
-
-void install() {
-  static const bool installed = [] {
-    struct sigaction action {};
-    action.sa_sigaction = on_sigbus;
-    action.sa_flags = SA_SIGINFO | SA_NODEFER;  // SIGBUS not blocked after the jump out
-    sigemptyset(&action.sa_mask);
-    return sigaction(SIGBUS, &action, &previous) == 0;
-  }();
-  (void)installed;
-}
-
-}  // namespace bus_guard
-}  // namespace
-
-// A classic pcap file (not pcapng), mapped: its records are read without a read() system call
-// or libpcap's copies. The rules are libpcap's (savefile.c, sf-pcap.c): a file header of 24
-// bytes, then records of a 16-byte header and the captured bytes; a record cut by the end of the
-// file is an error; a captured length over 262 144 bytes is an error; one over the file's snap
-// length is cut to it.
+// A classic pcap file (not pcapng), read by the process itself: pread() in large pieces into
+// one buffer, the records parsed where they lie (no stdio buffer, no libpcap copy). The rules
+// are libpcap's (savefile.c, sf-pcap.c): a file header of 24 bytes, then records of a 16-byte
+// header and the captured bytes; a record cut by the end of the file is an error; a captured
+// length over 262 144 bytes is an error; one over the file's snap length is cut to it.
+//
+// Not mapped: a mapped capture's every page is a page fault (a 54 MB capture, 13 000 pages; on
+// a paravirtualised AMD EPYC, Zen 5, about 40 ms of the replay thread's CPU against 12–16 ms for
+// the kernel's copy into this buffer), its pages count in the process's RSS, and a file truncated
+// meanwhile raises SIGBUS. The buffer stays in the core's cache: the record is read from there.
 struct ClassicPcap {
-  const std::uint8_t* data = nullptr;
-  std::size_t size = 0;
-  std::size_t at = 24;        // the next record
-  std::size_t released = 0;   // the mapping's pages before this are given back
+  int fd = -1;
+  std::unique_ptr<std::uint8_t[]> buffer;  // kBufferBytes
+  std::size_t begin = 0;                   // the unparsed bytes are buffer[begin, end)
+  std::size_t end = 0;
+  std::uint64_t read_to = 0;  // the file's offset of buffer[end]
   bool swapped = false;       // written on a machine of the other byte order
   bool nanoseconds = false;   // time stamps in ns (magic 0xA1B23C4D), else µs
   std::uint32_t snaplen = 0;  // of the file, as libpcap adjusts it
@@ -115,39 +88,73 @@ struct ClassicPcap {
   static constexpr std::uint32_t kMaxSnaplen = 262'144;  // libpcap's MAXIMUM_SNAPLEN
   static constexpr std::size_t kFileHeader = 24;
   static constexpr std::size_t kRecordHeader = 16;
+  // Room for the largest record twice over: each refill reads at least 256 KiB.
+  static constexpr std::size_t kBufferBytes = 2 * (kMaxSnaplen + kRecordHeader);
 
-  std::uint32_t u32(std::size_t offset) const noexcept {
+  ClassicPcap() = default;
+  ClassicPcap(const ClassicPcap&) = delete;
+  ClassicPcap& operator=(const ClassicPcap&) = delete;
+  ~ClassicPcap() {
+    if (fd >= 0) (void)::close(fd);
+  }
+
+  [[nodiscard]] std::uint64_t offset() const noexcept { return read_to - (end - begin); }
+
+  std::uint32_t u32(const std::uint8_t* p) const noexcept {
     std::uint32_t v = 0;
-    std::memcpy(&v, data + offset, sizeof v);
+    std::memcpy(&v, p, sizeof v);
     return swapped ? __builtin_bswap32(v) : v;
   }
-  std::uint16_t u16(std::size_t offset) const noexcept {
+  std::uint16_t u16(const std::uint8_t* p) const noexcept {
     std::uint16_t v = 0;
-    std::memcpy(&v, data + offset, sizeof v);
+    std::memcpy(&v, p, sizeof v);
     return swapped ? __builtin_bswap16(v) : v;
   }
 
-  // Every 4 MiB read, the pages behind are unmapped (the page cache keeps them): read pages of a
-  // mapped file count in the process's RSS, which grew by the capture's size in each lap of a
-  // looped replay (the soak's RSS check failed at +26 %).
-  void release_behind() noexcept {
-    constexpr std::size_t kStep = std::size_t{4} << 20;
-    if (at - released < kStep) return;
-    static const auto page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
-    const std::size_t until = at / page * page;
-    // The mapping starts on a page; `data` is const only to the parser.
-    (void)madvise(const_cast<std::uint8_t*>(data) + released, until - released, MADV_DONTNEED);
-    released = until;
+  // At least `bytes` (≤ kBufferBytes) unparsed, reading more as needed: true; false at the end
+  // of the file first (fewer are there), or on a read error (`error` says which).
+  bool have(std::size_t bytes, std::string& error) {
+    if (end - begin >= bytes) return true;
+    std::memmove(buffer.get(), buffer.get() + begin, end - begin);
+    end -= begin;
+    begin = 0;
+    while (end < bytes) {
+      const ssize_t got = ::pread(fd, buffer.get() + end, kBufferBytes - end, static_cast<off_t>(read_to));
+      if (got < 0) {
+        if (errno == EINTR) continue;
+        error = std::string("read error at byte ") + std::to_string(read_to) + ": " + std::strerror(errno);
+        return false;
+      }
+      if (got == 0) return false;
+      end += static_cast<std::size_t>(got);
+      read_to += static_cast<std::uint64_t>(got);
+    }
+    return true;
   }
 
-  // Reads the file header; false for anything but a classic pcap file of version 2.4 (libpcap
-  // then reads it, or says why not; older minors have quirks of their own).
-  bool open(const std::uint8_t* bytes, std::size_t length) noexcept {
-    if (length < kFileHeader) return false;
-    data = bytes;
-    size = length;
+  // Reads the header of `file`, which it then owns; false for anything but a classic pcap file of
+  // version 2.4, `file` left to the caller (libpcap then reads it: pread() did not move its
+  // offset; older minors have quirks of their own).
+  bool open(int file) {
+    fd = file;
+    buffer = std::make_unique_for_overwrite<std::uint8_t[]>(kBufferBytes);
+    host::populate(buffer.get(), kBufferBytes);
+    if (!classic_header()) {
+      fd = -1;
+      buffer.reset();
+      begin = end = 0;
+      read_to = 0;
+      return false;
+    }
+    return true;
+  }
+
+  bool classic_header() {
+    std::string ignored;
+    if (!have(kFileHeader, ignored)) return false;
+    const std::uint8_t* header = buffer.get();
     std::uint32_t magic = 0;
-    std::memcpy(&magic, data, sizeof magic);
+    std::memcpy(&magic, header, sizeof magic);
     switch (magic) {
       case 0xA1B2C3D4:
         break;
@@ -164,59 +171,67 @@ struct ClassicPcap {
       default:
         return false;
     }
-    if (u16(4) != 2 || u16(6) != 4) return false;
-    snaplen = u32(16);
+    if (u16(header + 4) != 2 || u16(header + 6) != 4) return false;
+    snaplen = u32(header + 16);
     if (snaplen == 0 || snaplen > kMaxSnaplen) snaplen = kMaxSnaplen;
-    const std::uint32_t link = u32(20) & 0x03FFFFFF;  // the upper bits say whether frames end in an FCS
+    const std::uint32_t link = u32(header + 20) & 0x03FFFFFF;  // the upper bits say whether frames end in an FCS
     link_type = link == kLinkRaw ? kLinkRawAlt : static_cast<int>(link);  // LINKTYPE_RAW is DLT_RAW
+    begin = kFileHeader;
     return true;
   }
 
-  // The next record's frame, copied into `frame_copy` (the mapping may not be read outside the
-  // guard).
-  PcapSource::Next next(std::vector<std::uint8_t>& frame_copy, std::size_t& length, std::int64_t& time_ns,
-                        std::string& error) noexcept {
-    sigjmp_buf jump;
-    if (sigsetjmp(jump, 0) != 0) {
-      bus_guard::active = nullptr;
+  // The file ended before a record did (`truncated`: libpcap's words for it; empty between
+  // records). A file shorter now than what was read of it was truncated by another program:
+  // said so (what was read before it is delivered).
+  PcapSource::Next ended(std::string truncated, std::string& error) const {
+    struct stat status {};
+    if (fstat(fd, &status) == 0 && static_cast<std::uint64_t>(status.st_size) < read_to) {
       error = "the capture file shrank while it was read (truncated by another program?): read error at byte " +
-              std::to_string(at);
+              std::to_string(offset());
       return PcapSource::Next::kError;
     }
-    bus_guard::active = &jump;
-    const PcapSource::Next got = next_unguarded(frame_copy, length, time_ns, error);
-    bus_guard::active = nullptr;
-    return got;
+    if (truncated.empty()) return PcapSource::Next::kEnd;
+    error = std::move(truncated);
+    return PcapSource::Next::kError;
   }
 
-  PcapSource::Next next_unguarded(std::vector<std::uint8_t>& frame_copy, std::size_t& length, std::int64_t& time_ns,
-                                  std::string& error) noexcept {
-    const std::size_t left = size - at;
-    if (left == 0) return PcapSource::Next::kEnd;
-    if (left < kRecordHeader) {
-      error = "truncated dump file; tried to read " + std::to_string(kRecordHeader) + " header bytes, only got " +
-              std::to_string(left);
-      return PcapSource::Next::kError;
+  // The next record's frame, in the buffer until the next call.
+  PcapSource::Next next(const std::uint8_t*& frame, std::size_t& length, std::int64_t& time_ns, std::string& error) {
+    std::string why;  // a read error
+    if (!have(kRecordHeader, why)) {
+      if (!why.empty()) {
+        error = why;
+        return PcapSource::Next::kError;
+      }
+      const std::size_t left = end - begin;
+      return ended(left == 0 ? std::string()
+                             : "truncated dump file; tried to read " + std::to_string(kRecordHeader) +
+                                   " header bytes, only got " + std::to_string(left),
+                   error);
     }
-    const std::uint32_t seconds = u32(at);
-    const std::uint32_t fraction = u32(at + 4);
-    const std::uint32_t captured = u32(at + 8);
+    const std::uint8_t* header = buffer.get() + begin;
+    const std::uint32_t seconds = u32(header);
+    const std::uint32_t fraction = u32(header + 4);
+    const std::uint32_t captured = u32(header + 8);
     if (captured > kMaxSnaplen) {
       error = "invalid packet capture length " + std::to_string(captured) + ", bigger than maximum of " +
               std::to_string(kMaxSnaplen);
       return PcapSource::Next::kError;
     }
-    if (left - kRecordHeader < captured) {
-      error = "truncated dump file; tried to read " + std::to_string(captured) + " captured bytes, only got " +
-              std::to_string(left - kRecordHeader);
-      return PcapSource::Next::kError;
+    if (!have(kRecordHeader + captured, why)) {
+      if (!why.empty()) {
+        error = why;
+        return PcapSource::Next::kError;
+      }
+      return ended("truncated dump file; tried to read " + std::to_string(captured) + " captured bytes, only got " +
+                       std::to_string(end - begin - kRecordHeader),
+                   error);
     }
+    frame = buffer.get() + begin + kRecordHeader;
     length = std::min(captured, snaplen);  // the rest of a record longer than the snap length is skipped
-    std::memcpy(frame_copy.data(), data + at + kRecordHeader, length);  // sized for kMaxSnaplen
     time_ns = static_cast<std::int64_t>(seconds) * 1'000'000'000 +
               static_cast<std::int64_t>(fraction) * (nanoseconds ? 1 : 1'000);
-    at += kRecordHeader + captured;
-    release_behind();
+    begin += kRecordHeader + captured;
     return PcapSource::Next::kDatagram;
   }
 };
@@ -224,64 +239,29 @@ struct ClassicPcap {
 struct PcapSource::Handle {
   pcap_t* pcap = nullptr;
   std::unique_ptr<char[]> buffer;  // the capture FILE's (glibc ignores a size without one)
-  void* mapping = MAP_FAILED;      // the whole capture, when it is a classic pcap file
-  std::size_t mapping_bytes = 0;
-  bool in_place = false;  // a classic pcap file, mapped: read by `classic`, not by libpcap
+  bool in_place = false;           // a classic pcap file: read by `classic`, not by libpcap
   ClassicPcap classic;
-  std::vector<std::uint8_t> frame;  // the last record's, copied out of the mapping
   ~Handle() {
-    if (pcap != nullptr) pcap_close(pcap);  // closes the FILE, before the buffer or mapping goes
-    if (mapping != MAP_FAILED) (void)munmap(mapping, mapping_bytes);
+    if (pcap != nullptr) pcap_close(pcap);  // closes the FILE before its buffer goes
   }
 };
 
-namespace {
-
-// A regular file's bytes, mapped, when they are a classic pcap file (the usual capture, and the
-// one trajroid records): no read() system call copies every byte into a stdio buffer first, nor
-// libpcap from there into its own (on an AMD EPYC, Zen 3, the kernel's copy alone was 9 % of an
-// as-fast replay's CPU). Anything else (pcapng, a pipe, an empty file) is read by libpcap as a
-// stream.
-bool map_classic_capture(int fd, void*& mapping, std::size_t& bytes, ClassicPcap& classic) {
-  struct stat status {};
-  if (fstat(fd, &status) != 0 || !S_ISREG(status.st_mode) || status.st_size <= 0) return false;
-  bytes = static_cast<std::size_t>(status.st_size);
-  mapping = mmap(nullptr, bytes, PROT_READ, MAP_PRIVATE, fd, 0);
-  if (mapping == MAP_FAILED) return false;
-  bus_guard::install();
-  volatile bool classic_file = false;  // kept across a jump back from the guard
-  {
-    sigjmp_buf jump;
-    if (sigsetjmp(jump, 0) == 0) {
-      bus_guard::active = &jump;
-      classic_file = classic.open(static_cast<const std::uint8_t*>(mapping), bytes);
-    }
-    bus_guard::active = nullptr;
-  }
-  if (!classic_file) {
-    (void)munmap(mapping, bytes);
-    mapping = MAP_FAILED;
-    return false;
-  }
-  (void)madvise(mapping, bytes, MADV_SEQUENTIAL);
-  return true;
-}
-
-}  // namespace
-
 PcapSource::PcapSource(const std::filesystem::path& path, PcapOptions options)
     : handle_(std::make_unique<Handle>()), options_(std::move(options)) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     const int error = errno;
     throw std::runtime_error(path.string() + ": cannot open capture: " + std::strerror(error));
   }
-  handle_->in_place = map_classic_capture(fd, handle_->mapping, handle_->mapping_bytes, handle_->classic);
-  if (handle_->in_place) {
-    (void)::close(fd);  // the mapping keeps the file
-    handle_->frame.resize(ClassicPcap::kMaxSnaplen);
+  // A regular file that is a classic pcap file (the usual capture, and the one trajroid
+  // records) is read by ClassicPcap; anything else (pcapng, a pipe, an empty file) by libpcap as
+  // a stream, from the start.
+  struct stat status {};
+  if (fstat(fd, &status) == 0 && S_ISREG(status.st_mode) && handle_->classic.open(fd)) {
+    handle_->in_place = true;
     link_type_ = handle_->classic.link_type;
-  } else {
+  }
+  if (!handle_->in_place) {
     std::FILE* file = fdopen(fd, "rb");
     if (file == nullptr) {
       const int error = errno;
@@ -312,10 +292,7 @@ PcapSource::Next PcapSource::next(Datagram& datagram, std::chrono::milliseconds 
 }
 
 PcapSource::Next PcapSource::next_record(const std::uint8_t*& frame, std::size_t& length, std::int64_t& time_ns) {
-  if (handle_->in_place) {
-    frame = handle_->frame.data();
-    return handle_->classic.next(handle_->frame, length, time_ns, error_);
-  }
+  if (handle_->in_place) return handle_->classic.next(frame, length, time_ns, error_);
   pcap_pkthdr* header = nullptr;
   const int status = pcap_next_ex(handle_->pcap, &header, &frame);
   if (status == PCAP_ERROR_BREAK) return Next::kEnd;

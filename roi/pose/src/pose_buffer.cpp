@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "trajroi/host/memory.hpp"
+
 namespace trajroi::pose {
 
 std::string_view to_string(RtkSolution s) noexcept {
@@ -128,7 +130,12 @@ PoseBuffer::PoseBuffer(const PoseGate& gate, const Eigen::Vector3d& antenna_in_r
     throw std::invalid_argument("pose gate: extrapolation must be ≥ 0, gap and accuracy bounds > 0");
   }
   if (!antenna_in_robot_m.allFinite()) throw std::invalid_argument("pose buffer: antenna lever arm is not finite");
+  // Resident before they are written (one system call, not a page fault per page).
+  fixes_.items.reserve(capacity);
+  host::populate(fixes_.items.data(), capacity * sizeof(StoredFix));
   fixes_.items.resize(capacity);
+  attitudes_.items.reserve(capacity);
+  host::populate(attitudes_.items.data(), capacity * sizeof(StoredAttitude));
   attitudes_.items.resize(capacity);
 }
 

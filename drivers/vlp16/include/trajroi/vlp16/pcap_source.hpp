@@ -2,9 +2,9 @@
 
 // Reading Velodyne UDP payloads from a pcap capture. An I/O adapter: kept out of the pure
 // decoder's target. A classic pcap file (version 2.4, either byte order, µs or ns time stamps)
-// is mapped and its records copied out by libpcap's rules, without read() or libpcap's copies;
-// a file truncated by another program while it is read gives a read error, not a SIGBUS.
-// Anything else (pcapng, a pipe) is read by libpcap as a stream.
+// is read in large pieces into one buffer and its records parsed there by libpcap's rules,
+// without libpcap's copies; a file truncated by another program while it is read gives a read
+// error that says so. Anything else (pcapng, a pipe) is read by libpcap as a stream.
 #include <chrono>
 #include <cstdint>
 #include <filesystem>

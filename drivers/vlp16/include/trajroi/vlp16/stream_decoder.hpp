@@ -139,12 +139,9 @@ struct DecodedPacket {
   std::uint64_t tag = 0;
   Model model = Model::kVlp16;  // of the decoder that decoded it
   PacketDecoder::Result result;
-  // Room for a whole packet, its memory touched: decoding into it never allocates nor faults.
+  // Room for a whole packet, its memory resident: decoding into it never allocates nor faults.
   std::vector<Point> points;
-  DecodedPacket() {
-    points.resize(kPointsPerPacket);
-    points.clear();
-  }
+  DecodedPacket();
 };
 
 class StreamDecoder {
