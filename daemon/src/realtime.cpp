@@ -8,6 +8,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "trajroi/host/memory.hpp"
+
 namespace trajroi::daemon {
 
 std::string apply_thread_config(const char* name, const ThreadConfig& config) {
@@ -45,8 +47,8 @@ std::string lock_memory() {
 
 void prefault_stack(std::size_t bytes) {
   auto* volatile stack = static_cast<volatile unsigned char*>(alloca(bytes));
-  for (std::size_t i = 0; i < bytes; i += 4096)
-    stack[i] = 0;
+  host::populate(const_cast<unsigned char*>(stack), bytes);
+  stack[0] = 0;  // the region in use while it is populated
 }
 
 }  // namespace trajroi::daemon

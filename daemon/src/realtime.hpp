@@ -17,7 +17,7 @@ std::string apply_thread_config(const char* name, const ThreadConfig& config);
 // mlockall(MCL_CURRENT | MCL_FUTURE). Empty on success, else a warning.
 std::string lock_memory();
 
-// Touches `bytes` of stack so the thread's stack pages are resident before the steady state.
+// Makes `bytes` of stack below the caller resident (host::populate) before the steady state.
 void prefault_stack(std::size_t bytes = 256 * 1024);
 
 }  // namespace trajroi::daemon
