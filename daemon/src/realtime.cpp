@@ -46,9 +46,8 @@ std::string lock_memory() {
 }
 
 void prefault_stack(std::size_t bytes) {
-  auto* volatile stack = static_cast<volatile unsigned char*>(alloca(bytes));
-  host::populate(const_cast<unsigned char*>(stack), bytes);
-  stack[0] = 0;  // the region in use while it is populated
+  // The pages below this frame, `bytes` deep: the thread's calls later stay within them.
+  host::populate(alloca(bytes), bytes);
 }
 
 }  // namespace trajroi::daemon
