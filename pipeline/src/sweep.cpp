@@ -8,7 +8,7 @@ namespace {
 
 // Makes an array's whole capacity resident (see Sweep::make_resident).
 template <typename Array>
-void touch_capacity(Array& a) {
+void make_capacity_resident(Array& a) {
   host::populate(a.data(), a.capacity() * sizeof(typename Array::value_type));
 }
 
@@ -48,13 +48,13 @@ void PointColumns::swap(PointColumns& other) noexcept {
 
 void PointColumns::make_resident() {
   clear();
-  touch_capacity(x);
-  touch_capacity(y);
-  touch_capacity(z);
-  touch_capacity(intensity);
-  touch_capacity(ring);
-  touch_capacity(return_type);
-  touch_capacity(time_offset_ns);
+  make_capacity_resident(x);
+  make_capacity_resident(y);
+  make_capacity_resident(z);
+  make_capacity_resident(intensity);
+  make_capacity_resident(ring);
+  make_capacity_resident(return_type);
+  make_capacity_resident(time_offset_ns);
 }
 
 void PointColumns::clear() noexcept {
@@ -85,7 +85,7 @@ void Sweep::reserve(std::size_t points, std::size_t centre_count, std::size_t ra
 void Sweep::make_resident() {
   clear_points();
   PointColumns::make_resident();
-  touch_capacity(sensor_index);
+  make_capacity_resident(sensor_index);
   raw.make_resident();
 }
 

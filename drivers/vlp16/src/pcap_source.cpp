@@ -111,10 +111,11 @@ struct ClassicPcap {
     return swapped ? __builtin_bswap16(v) : v;
   }
 
-  // At least `bytes` (≤ kBufferBytes) unparsed, reading more as needed: true; false at the end
-  // of the file first (fewer are there), or on a read error (`error` says which).
-  bool have(std::size_t bytes, std::string& error) {
-    if (end - begin >= bytes) return true;
+  // At least `bytes` (≤ kBufferBytes) unparsed, reading more as needed: kYes; kEnd when the file
+  // ends first (fewer are there); kError on a read error, which `error` says.
+  enum class Have { kYes, kEnd, kError };
+  Have have(std::size_t bytes, std::string& error) {
+    if (end - begin >= bytes) return Have::kYes;
     std::memmove(buffer.get(), buffer.get() + begin, end - begin);
     end -= begin;
     begin = 0;
@@ -123,13 +124,13 @@ struct ClassicPcap {
       if (got < 0) {
         if (errno == EINTR) continue;
         error = std::string("read error at byte ") + std::to_string(read_to) + ": " + std::strerror(errno);
-        return false;
+        return Have::kError;
       }
-      if (got == 0) return false;
+      if (got == 0) return Have::kEnd;
       end += static_cast<std::size_t>(got);
       read_to += static_cast<std::uint64_t>(got);
     }
-    return true;
+    return Have::kYes;
   }
 
   // Reads the header of `file`, which it then owns; false for anything but a classic pcap file of
@@ -151,7 +152,7 @@ struct ClassicPcap {
 
   bool classic_header() {
     std::string ignored;
-    if (!have(kFileHeader, ignored)) return false;
+    if (have(kFileHeader, ignored) != Have::kYes) return false;
     const std::uint8_t* header = buffer.get();
     std::uint32_t magic = 0;
     std::memcpy(&magic, header, sizeof magic);
@@ -197,12 +198,8 @@ struct ClassicPcap {
 
   // The next record's frame, in the buffer until the next call.
   PcapSource::Next next(const std::uint8_t*& frame, std::size_t& length, std::int64_t& time_ns, std::string& error) {
-    std::string why;  // a read error
-    if (!have(kRecordHeader, why)) {
-      if (!why.empty()) {
-        error = why;
-        return PcapSource::Next::kError;
-      }
+    if (const Have h = have(kRecordHeader, error); h != Have::kYes) {
+      if (h == Have::kError) return PcapSource::Next::kError;
       const std::size_t left = end - begin;
       return ended(left == 0 ? std::string()
                              : "truncated dump file; tried to read " + std::to_string(kRecordHeader) +
@@ -218,11 +215,8 @@ struct ClassicPcap {
               std::to_string(kMaxSnaplen);
       return PcapSource::Next::kError;
     }
-    if (!have(kRecordHeader + captured, why)) {
-      if (!why.empty()) {
-        error = why;
-        return PcapSource::Next::kError;
-      }
+    if (const Have h = have(kRecordHeader + captured, error); h != Have::kYes) {
+      if (h == Have::kError) return PcapSource::Next::kError;
       return ended("truncated dump file; tried to read " + std::to_string(captured) + " captured bytes, only got " +
                        std::to_string(end - begin - kRecordHeader),
                    error);

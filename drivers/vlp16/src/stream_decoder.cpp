@@ -12,6 +12,7 @@ DecodedPacket::DecodedPacket() {
   points.reserve(kPointsPerPacket);
   host::populate(points.data(), kPointsPerPacket * sizeof(Point));
 }
+
 namespace {
 
 constexpr double kLossFactor = 1.5;  // a step beyond 1.5 expected ones means packets are missing
