@@ -144,8 +144,9 @@ struct Pipeline {
   // the same on every run); otherwise a full ring drops the newest item and counts it.
   // Otherwise, too, the sweeps' memory is made resident at start (Sweep::make_resident, here,
   // in the processor and the publisher: about 25 MB at the default buffers, 12 ms on a VM), so
-  // that the daemon's memory is flat from its first sweep and no sweep takes a page fault; an
-  // as-fast replay, a batch job whose start-up is part of its time, lets it fault in as used.
+  // that the daemon's memory is flat from its first sweep and no sweep takes a page fault; in
+  // an as-fast replay, a batch job whose start-up is part of its time and whose sweeps use a
+  // tenth of their room, each sweep is made resident as it fills (Sweep::make_resident_to).
   Pipeline(const DaemonConfig& config, bool exact, bool record);
   ~Pipeline();
   Pipeline(const Pipeline&) = delete;

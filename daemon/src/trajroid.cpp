@@ -277,12 +277,14 @@ int run_daemon(const DaemonConfig& config, std::unique_ptr<pipeline::ActiveTraje
     log::critical("{}: {}", config.file.string(), e.what());
     return kExitConfig;
   }
-  // The scans are timed on another thread while the rings are allocated and touched and the
-  // sources opened, and the decoder's builds on this one after that (start-up is part of a
-  // replay's time: one after the other, the scans and the decoder kept this thread waiting
-  // 2–3 ms); a path forced by TRAJROI_SIMD is taken at once.
-  std::future<roi::ScanCalibration> scan =
-      std::async(std::launch::async, [&processor] { return processor->calibrate_scan(); });
+  // The scans and then the decoder's builds are timed on another thread while the rings are
+  // allocated and the sources opened (start-up is part of a replay's time: on this one, they
+  // kept it waiting 3–5 ms); a path forced by TRAJROI_SIMD is taken at once.
+  std::future<roi::ScanCalibration> scan = std::async(std::launch::async, [&processor] {
+    const roi::ScanCalibration calibration = processor->calibrate_scan();
+    (void)vlp16::decoder_calibration();
+    return calibration;
+  });
   const bool exact = options.replay.has_value() && options.rate == 0.0;
   if (!exact) processor->make_resident();  // see Pipeline::exact
   Pipeline pipeline(config, exact, options.record.has_value());
@@ -318,7 +320,6 @@ int run_daemon(const DaemonConfig& config, std::unique_ptr<pipeline::ActiveTraje
   if (config.realtime.lock_memory) {
     if (const std::string w = lock_memory(); !w.empty()) log::warn("{}", w);
   }
-  (void)vlp16::decoder_calibration();
   log_scan_calibration(scan.get(), config.roi.shape);
   log::info("trajroid running: {} → LCM {} ({}, {}, {}, {}; trajectory input on {})",
             options.replay ? "replay of " + options.replay->string() : std::string("live sensors"), url,

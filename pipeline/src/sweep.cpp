@@ -1,5 +1,8 @@
 #include "trajroi/pipeline/sweep.hpp"
 
+#include <algorithm>
+#include <utility>
+
 #include "trajroi/host/memory.hpp"
 #include "trajroi/roi/transform.hpp"
 
@@ -10,6 +13,13 @@ namespace {
 template <typename Array>
 void make_capacity_resident(Array& a) {
   host::populate(a.data(), a.capacity() * sizeof(typename Array::value_type));
+}
+
+// Makes elements [from, to) of an array's capacity resident.
+template <typename Array>
+void make_range_resident(Array& a, std::size_t from, std::size_t to) {
+  to = std::min(to, a.capacity());
+  if (from < to) host::populate(a.data() + from, (to - from) * sizeof(typename Array::value_type));
 }
 
 }  // namespace
@@ -27,6 +37,7 @@ Eigen::Isometry3d PublishedPose::isometry() const {
 }
 
 void PointColumns::reserve(std::size_t points) {
+  if (points > x.capacity()) resident = 0;  // moved to new memory
   x.reserve(points);
   y.reserve(points);
   z.reserve(points);
@@ -44,6 +55,7 @@ void PointColumns::swap(PointColumns& other) noexcept {
   ring.swap(other.ring);
   return_type.swap(other.return_type);
   time_offset_ns.swap(other.time_offset_ns);
+  std::swap(resident, other.resident);
 }
 
 void PointColumns::make_resident() {
@@ -55,6 +67,21 @@ void PointColumns::make_resident() {
   make_capacity_resident(ring);
   make_capacity_resident(return_type);
   make_capacity_resident(time_offset_ns);
+  resident = x.capacity();
+}
+
+void PointColumns::make_resident_to(std::size_t points) {
+  if (points <= resident) return;
+  const std::size_t from = resident;
+  const std::size_t to = std::min(x.capacity(), std::max(points, from + kResidentStep));
+  make_range_resident(x, from, to);
+  make_range_resident(y, from, to);
+  make_range_resident(z, from, to);
+  make_range_resident(intensity, from, to);
+  make_range_resident(ring, from, to);
+  make_range_resident(return_type, from, to);
+  make_range_resident(time_offset_ns, from, to);
+  resident = to;
 }
 
 void PointColumns::clear() noexcept {
@@ -87,6 +114,12 @@ void Sweep::make_resident() {
   PointColumns::make_resident();
   make_capacity_resident(sensor_index);
   raw.make_resident();
+}
+
+void Sweep::make_resident_to(std::size_t points) {
+  const std::size_t from = resident;
+  PointColumns::make_resident_to(points);
+  make_range_resident(sensor_index, from, resident);
 }
 
 void Sweep::clear_points() noexcept {

@@ -77,6 +77,7 @@ pose::PoseStatus SweepProcessor::filter_batch(Lane& lane, const vlp16::Frame& fr
   // Grown once, then written through pointers (push_back would store each array's end at
   // every point: the compiler cannot tell the arrays apart).
   const std::size_t at = s.size();
+  s.make_resident_to(at + n);
   const auto grown = [at, n](auto& v) {
     v.resize(at + n);
     return v.data() + at;

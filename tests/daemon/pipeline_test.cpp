@@ -7,8 +7,6 @@
 #include <gtest/gtest.h>
 #include <spdlog/sinks/ringbuffer_sink.h>
 #include <spdlog/spdlog.h>
-#include <sys/mman.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -23,6 +21,7 @@
 #include "daemon_fixture.hpp"
 #include "outlet.hpp"
 #include "reload.hpp"
+#include "resident.hpp"
 #include "trajroi/daemon/config.hpp"
 #include "trajroi/eval/scenario_eval.hpp"
 #include "trajroi/inputs/pacer.hpp"
@@ -196,21 +195,8 @@ TEST(Pipeline, ThreeFakeInputLanesThroughTheThreadsGiveTheProcessorsOwnSweeps) {
   EXPECT_EQ(last.sweeps_published, static_cast<std::int64_t>(published.size()));
 }
 
-// Whether every page wholly inside [data, data + bytes) is resident (mincore).
-bool resident(const void* data, std::size_t bytes) {
-  const auto page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
-  const std::uintptr_t first = (reinterpret_cast<std::uintptr_t>(data) + page - 1) / page * page;
-  const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) / page * page;
-  if (end <= first) return true;
-  std::vector<unsigned char> in((end - first) / page);
-  if (::mincore(reinterpret_cast<void*>(first), end - first, in.data()) != 0) return false;
-  return std::all_of(in.begin(), in.end(), [](unsigned char c) { return (c & 1U) != 0; });
-}
-
-template <typename Array>
-bool resident_capacity(const Array& a) {
-  return resident(a.data(), a.capacity() * sizeof(typename Array::value_type));
-}
+using test_memory::resident;
+using test_memory::resident_capacity;
 
 // Live (and a timed replay): the sweeps' arrays and a LiDAR lane's ring of packets decoded
 // ahead are allocated and resident before the first datagram, so a flood or a busier scene
@@ -225,9 +211,9 @@ TEST(Pipeline, SweepsAndTheDecodeAheadRingAreResidentFromTheStart) {
   ASSERT_NE(lidar.decoded, nullptr);
   std::size_t packets = 0;
   while (lidar.decoded->try_push([&](trajroi::vlp16::DecodedPacket& d) {
-    EXPECT_TRUE(d.points.empty());
-    EXPECT_GE(d.points.capacity(), trajroi::vlp16::kPointsPerPacket);
-    EXPECT_TRUE(resident_capacity(d.points)) << "decoded packet " << packets;
+    EXPECT_EQ(d.count, 0U);
+    EXPECT_EQ(d.points.size(), trajroi::vlp16::kPointsPerPacket);
+    EXPECT_TRUE(resident(&d, sizeof d)) << "decoded packet " << packets;
   }))
     ++packets;
   EXPECT_EQ(packets, lidar.decoded->capacity());

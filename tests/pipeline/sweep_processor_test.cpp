@@ -7,9 +7,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "daemon_fixture.hpp"
+#include "resident.hpp"
 #include "trajroi/daemon/config.hpp"
 #include "trajroi/inputs/run_merger.hpp"
 #include "trajroi/roi/trajectory.hpp"
@@ -140,6 +142,44 @@ TEST(Sweep, TakeExchangesThePointArraysAndCopiesTheHeader) {
   EXPECT_EQ(arrays(built), slot_arrays);
   EXPECT_GE(built.x.capacity(), 64U);
   EXPECT_EQ(built.index, 41U);  // the processor's header is left as it was
+}
+
+// A sweep that was not made resident (an as-fast replay's) becomes so as it fills, a step of
+// points at a time, and its residence goes with its arrays when the publisher's ring takes it.
+TEST(Sweep, BecomesResidentAStepAtATimeAsItFillsAndTheResidenceGoesWithItsArrays) {
+  using test_memory::any_resident;
+  using test_memory::resident;
+  constexpr std::size_t kStep = Sweep::kResidentStep;
+  // 36 MB a float array: above glibc's largest mapping threshold, so its own fresh mapping.
+  constexpr std::size_t kPoints = 9'000'000;
+  Sweep built, slot;
+  built.reserve(kPoints, 8);
+  slot.reserve(kPoints, 8);
+  const auto floats = [](std::size_t n) { return n * sizeof(float); };
+  ASSERT_FALSE(any_resident(built.x.data(), floats(kPoints))) << "fresh memory expected";
+  EXPECT_EQ(built.resident, 0U);
+
+  built.make_resident_to(100);  // a whole step
+  EXPECT_EQ(built.resident, kStep);
+  EXPECT_TRUE(resident(built.x.data(), floats(kStep)));
+  EXPECT_TRUE(resident(built.time_offset_ns.data(), kStep * sizeof(std::int32_t)));
+  EXPECT_TRUE(resident(built.return_type.data(), kStep));
+  EXPECT_TRUE(resident(built.sensor_index.data(), kStep));
+  EXPECT_FALSE(any_resident(built.x.data() + kStep, floats(kPoints - kStep)));
+
+  built.make_resident_to(kStep);  // already
+  EXPECT_EQ(built.resident, kStep);
+  built.make_resident_to(3 * kStep + 5);  // past a step: up to it
+  EXPECT_EQ(built.resident, 3 * kStep + 5);
+  EXPECT_TRUE(resident(built.y.data(), floats(3 * kStep)));
+  EXPECT_FALSE(any_resident(built.y.data() + 3 * kStep + 1024, floats(kPoints - 3 * kStep - 1024)));
+
+  slot.take(built);
+  EXPECT_EQ(slot.resident, 3 * kStep + 5);
+  EXPECT_EQ(built.resident, 0U);
+  built.make_resident();
+  EXPECT_EQ(built.resident, built.x.capacity());
+  EXPECT_TRUE(resident(built.z.data(), floats(kPoints)));
 }
 
 TEST(SweepProcessor, TheRoiGrowsWithSpeedAndTheGrowthIsCapped) {

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <thread>
 
+#include "resident.hpp"
 #include "trajroi/transport/ring_lane.hpp"
 
 namespace {
@@ -41,6 +42,44 @@ struct Payload {
   std::uint64_t sequence = 0;
   std::array<std::uint64_t, 15> copies{};  // every copy = sequence: a torn read shows
 };
+
+// The slots are one allocation, resident from construction (one populate, not a page fault
+// a page), each built by make() or value-initialised; their items are destroyed with the ring.
+TEST(SpscRing, ItsSlotsAreResidentFromConstructionAndBuiltByMake) {
+  struct Big {
+    std::array<std::uint8_t, 40000> bytes;  // 1 024 slots: 40 MB, a fresh mapping of its own
+  };
+  SpscRing<Big> ring(1024);
+  for (std::size_t i = 0; i < ring.capacity(); ++i) {
+    Big* slot = ring.try_claim();
+    ASSERT_NE(slot, nullptr);
+    ASSERT_TRUE(test_memory::resident(slot, sizeof(Big))) << "slot " << i;
+    ASSERT_EQ(slot->bytes[0] + slot->bytes[sizeof slot->bytes - 1], 0) << "value-initialised";
+    ring.publish();
+  }
+  static int alive = 0;
+  struct Counted {
+    int value = 0;
+    explicit Counted(int v) : value(v) { ++alive; }
+    Counted(Counted&& other) noexcept : value(other.value) { ++alive; }
+    Counted(const Counted&) = delete;
+    Counted& operator=(Counted&&) noexcept = default;
+    Counted& operator=(const Counted&) = delete;
+    ~Counted() { --alive; }
+  };
+  {
+    int made = 0;
+    SpscRing<Counted> counted(4, [&made] { return Counted(10 + made++); });
+    EXPECT_EQ(alive, 4);
+    for (int i = 0; i < 4; ++i) {
+      const Counted* c = counted.try_claim();
+      ASSERT_NE(c, nullptr);
+      EXPECT_EQ(c->value, 10 + i);
+      counted.publish();
+    }
+  }
+  EXPECT_EQ(alive, 0);
+}
 
 TEST(SpscRing, TwoThreadsPassTwoMillionItemsWithoutLossTearingOrReordering) {
   SpscRing<Payload> ring(64);

@@ -9,8 +9,10 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "model_replay.hpp"
 #include "trajroi/vlp16/pcap_source.hpp"
@@ -37,7 +39,9 @@ struct Replay {
 inline Replay replay(const std::filesystem::path& path, const Calibration& calibration = Calibration::vlp16_default(),
                      StreamOptions options = {}, const PacketDecoder* ahead = nullptr) {
   Replay r;
-  DecodedPacket decoded;
+  auto decoded_ahead = std::make_unique<DecodedPacket>();  // 11 kB: not on the stack
+  DecodedPacket& decoded = *decoded_ahead;
+  std::vector<Point> ahead_points;
   PcapSource source(path);
   StreamDecoder decoder(calibration, options);
   Datagram datagram;
@@ -60,8 +64,9 @@ inline Replay replay(const std::filesystem::path& path, const Calibration& calib
     }
     const bool decode_ahead = ahead != nullptr && validate_data_packet(datagram.payload) == PacketError::kNone;
     if (decode_ahead) {
-      decoded.points.clear();
-      decoded.result = ahead->decode(datagram.payload, decoded.points);
+      ahead_points.clear();
+      const PacketDecoder::Result result = ahead->decode(datagram.payload, ahead_points);
+      decoded.assign(ahead_points, result);
     }
     decoder.on_data_packet(datagram.payload, datagram.receive_time_ns, r.frames, decode_ahead ? &decoded : nullptr);
   }

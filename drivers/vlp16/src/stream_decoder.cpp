@@ -4,13 +4,12 @@
 #include <cmath>
 #include <cstdlib>
 
-#include "trajroi/host/memory.hpp"
-
 namespace trajroi::vlp16 {
 
-DecodedPacket::DecodedPacket() {
-  points.reserve(kPointsPerPacket);
-  host::populate(points.data(), kPointsPerPacket * sizeof(Point));
+void DecodedPacket::assign(std::span<const Point> decoded_points, const PacketDecoder::Result& decode_result) noexcept {
+  count = static_cast<std::uint32_t>(std::min(decoded_points.size(), points.size()));
+  std::copy_n(decoded_points.begin(), count, points.begin());
+  result = decode_result;
 }
 
 namespace {
@@ -299,7 +298,8 @@ PacketDecoder::Result StreamDecoder::decode_onto_frame(std::span<const std::uint
   PacketDecoder::Result r;
   if (decoded != nullptr) {
     reserve_packet_room(points);  // as decode() grows it
-    points.insert(points.end(), decoded->points.begin(), decoded->points.end());
+    const std::span<const Point> ahead = decoded->decoded();
+    points.insert(points.end(), ahead.begin(), ahead.end());
     r = decoded->result;
     ++counters_.decoded_ahead;
   } else {

@@ -94,8 +94,8 @@ std::string describe(PoseStatus status, double measured, double limit, const Pos
 
 template <class T>
 void PoseBuffer::Ring<T>::push(const T& item) noexcept {
-  if (size < items.size()) {
-    items[(head + size) % items.size()] = item;
+  if (items.size() < capacity) {  // filling (head is 0): the items are written as they come
+    items.push_back(item);
     ++size;
   } else {
     items[head] = item;
@@ -130,13 +130,14 @@ PoseBuffer::PoseBuffer(const PoseGate& gate, const Eigen::Vector3d& antenna_in_r
     throw std::invalid_argument("pose gate: extrapolation must be ≥ 0, gap and accuracy bounds > 0");
   }
   if (!antenna_in_robot_m.allFinite()) throw std::invalid_argument("pose buffer: antenna lever arm is not finite");
-  // Resident before they are written (one system call, not a page fault per page).
+  // Resident before they are written (one system call, not a page fault per page), and
+  // written only as samples come (not value-initialised first: 1.3 MB at the default).
   fixes_.items.reserve(capacity);
+  fixes_.capacity = capacity;
   host::populate(fixes_.items.data(), capacity * sizeof(StoredFix));
-  fixes_.items.resize(capacity);
   attitudes_.items.reserve(capacity);
+  attitudes_.capacity = capacity;
   host::populate(attitudes_.items.data(), capacity * sizeof(StoredAttitude));
-  attitudes_.items.resize(capacity);
 }
 
 bool PoseBuffer::add_fix(const GnssFix& fix) noexcept {

@@ -24,6 +24,8 @@
 #include <type_traits>
 #include <utility>
 
+#include "trajroi/host/memory.hpp"
+
 namespace trajroi::transport {
 
 inline constexpr std::size_t kCacheLine = 64;
@@ -31,15 +33,14 @@ inline constexpr std::size_t kCacheLine = 64;
 template <typename T>
 class SpscRing {
  public:
-  // `capacity` is rounded up to a power of two (at least 2). Every slot is constructed now
-  // with `make()` (or value-initialised) and its memory touched, so the steady state takes no
-  // page faults.
-  explicit SpscRing(std::size_t capacity) : mask_(round_up(capacity) - 1), slots_(new Slot[mask_ + 1]()) {}
+  // `capacity` is rounded up to a power of two (at least 2). The slots' memory is made
+  // resident in one call (host::populate), not a page fault per page, and every slot is then
+  // constructed with `make()` (or value-initialised), so the steady state takes no page faults.
+  explicit SpscRing(std::size_t capacity)
+      : mask_(round_up(capacity) - 1), slots_(make_slots(mask_ + 1, [](void* at) { ::new (at) Slot(); })) {}
   template <typename Make>
-  SpscRing(std::size_t capacity, Make make) : mask_(round_up(capacity) - 1), slots_(new Slot[mask_ + 1]) {
-    for (std::size_t i = 0; i <= mask_; ++i)
-      slots_[i].item = make();
-  }
+  SpscRing(std::size_t capacity, Make make)
+      : mask_(round_up(capacity) - 1), slots_(make_slots(mask_ + 1, [&make](void* at) { ::new (at) Slot{make()}; })) {}
 
   SpscRing(const SpscRing&) = delete;
   SpscRing& operator=(const SpscRing&) = delete;
@@ -122,9 +123,30 @@ class SpscRing {
   struct alignas(kCacheLine) Slot {
     T item;
   };
+  struct DestroySlots {
+    std::size_t count = 0;  // constructed
+    void operator()(Slot* slots) const noexcept {
+      for (std::size_t i = 0; i < count; ++i)
+        slots[i].~Slot();
+      ::operator delete (slots, std::align_val_t{alignof(Slot)});
+    }
+  };
+  using Slots = std::unique_ptr<Slot[], DestroySlots>;
+  // `count` slots in one resident allocation, each built by construct(address).
+  template <typename Construct>
+  static Slots make_slots(std::size_t count, Construct construct) {
+    void* memory = ::operator new (count * sizeof(Slot), std::align_val_t{alignof(Slot)});
+    host::populate(memory, count * sizeof(Slot));
+    Slots slots(static_cast<Slot*>(memory), DestroySlots{});
+    for (std::size_t i = 0; i < count; ++i) {
+      construct(static_cast<void*>(slots.get() + i));  // a throw destroys the ones before
+      slots.get_deleter().count = i + 1;
+    }
+    return slots;
+  }
 
   const std::size_t mask_;
-  const std::unique_ptr<Slot[]> slots_;
+  const Slots slots_;
   // Producer's line: its index and its cached copy of the consumer's.
   alignas(kCacheLine) std::atomic<std::size_t> tail_{0};
   std::size_t head_cache_ = 0;

@@ -139,9 +139,14 @@ struct DecodedPacket {
   std::uint64_t tag = 0;
   Model model = Model::kVlp16;  // of the decoder that decoded it
   PacketDecoder::Result result;
-  // Room for a whole packet, its memory resident: decoding into it never allocates nor faults.
-  std::vector<Point> points;
-  DecodedPacket();
+  // The first `count` of `points`: room for a whole packet inside the object, so that a ring
+  // of them is one allocation, made resident at once (SpscRing), that never allocates again.
+  std::uint32_t count = 0;
+  std::array<Point, kPointsPerPacket> points;
+
+  [[nodiscard]] std::span<const Point> decoded() const noexcept { return {points.data(), count}; }
+  // Keeps the points PacketDecoder::decode() gave (at most kPointsPerPacket) with its result.
+  void assign(std::span<const Point> decoded_points, const PacketDecoder::Result& decode_result) noexcept;
 };
 
 class StreamDecoder {

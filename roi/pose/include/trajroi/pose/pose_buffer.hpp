@@ -129,7 +129,8 @@ class PoseBuffer {
  private:
   template <class T>
   struct Ring {
-    std::vector<T> items;
+    std::vector<T> items;  // grows to `capacity` (reserved), then is written over
+    std::size_t capacity = 0;
     std::size_t head = 0;  // index of the oldest
     std::size_t size = 0;
     [[nodiscard]] const T& at(std::size_t i) const noexcept {
