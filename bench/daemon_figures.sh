@@ -10,7 +10,7 @@
 # steadily the machine gave a thread its CPU meanwhile (its longest slow spell).
 # Usage: bench/daemon_figures.sh [BUILD_DIR]   (default build/release)
 set -euo pipefail
-export LC_NUMERIC=C  # EPOCHREALTIME and awk agree on the decimal point
+export LC_NUMERIC=C  # bash's time and awk agree on the decimal point
 cd "$(dirname "$0")/.."
 # shellcheck source=scripts/lib/host.sh
 . scripts/lib/host.sh  # steal_ms: the host's steal over each run
@@ -25,16 +25,16 @@ duration=$(awk '/^duration_s/ {print $2}' "$run/summary.txt")
 # slow; a latency tail measured during such a spell is the machine's.
 steady="$(dirname "$run")/steady.txt"
 figures() {  # rate [run] → "latency_p50 latency_p99 drops wall_s cpu_s pipeline_cpu_s spell_ms spell_factor run_s steal_ms"
-  local log start end witness= steal0 folder=${2:-$run}
+  local log witness= steal0 folder=${2:-$run}
   steal0=$(steal_ms)
   if [ "$1" = realtime ]; then
     "$build/tools/trajroi" machine --seconds "$duration" --brief >"$steady" 2>/dev/null &
     witness=$!
   fi
-  start=$EPOCHREALTIME  # wall time to the millisecond (time's %e has 10 ms steps)
-  log=$( { /usr/bin/time -f "TIME %e %U %S" "$build/daemon/trajroid" --config "$folder/trajroid.yaml" \
-           --replay "$folder" --rate "$1" 2>&1; } 2>&1 )
-  end=$EPOCHREALTIME
+  # The process's wall, user and system time from bash's `time` (to the millisecond), which
+  # times the process itself: /usr/bin/time would add its own start (5 ms on a VM) to the wall.
+  local TIMEFORMAT='TIME %R %U %S'
+  log=$( { time "$build/daemon/trajroid" --config "$folder/trajroid.yaml" --replay "$folder" --rate "$1" 2>&1; } 2>&1 )
   local summary
   summary=$(grep "summary:" <<<"$log")
   local p50 p99 drops run_s
@@ -43,9 +43,8 @@ figures() {  # rate [run] → "latency_p50 latency_p99 drops wall_s cpu_s pipeli
   p50=$(sed -n 's/.*latency p50 \([0-9.]*\) ms.*/\1/p' <<<"$summary")
   p99=$(sed -n 's/.*p99 \([0-9.]*\) ms over.*/\1/p' <<<"$summary")
   drops=$(sed -n 's/.*ring drops \([0-9]*\).*/\1/p' <<<"$summary")
-  read -r _ _ user sys < <(grep "^TIME" <<<"$log")
-  local wall
-  wall=$(awk -v a="$start" -v b="$end" 'BEGIN {printf "%.3f", b - a}')
+  local wall user sys
+  read -r _ wall user sys < <(grep "^TIME" <<<"$log")
   local pipeline
   pipeline=$(sed -n 's/.*processing \([0-9.]*\) s, publishing \([0-9.]*\) s.*/\1 \2/p' <<<"$log" | awk '{print $1 + $2}')
   local spell="- -"

@@ -8,7 +8,7 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   # libraries
   libeigen3-dev libpcap-dev libgeographiclib-dev libserialport-dev libspdlog-dev
-  libyaml-cpp-dev libcli11-dev libsystemd-dev
+  libyaml-cpp-dev libcli11-dev
   # LCM: C/C++ library, lcm-gen, Java types for lcm-spy
   liblcm-dev liblcm-bin liblcm-java libjchart2d-java default-jdk-headless
   # tests and benchmarks

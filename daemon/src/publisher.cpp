@@ -1,12 +1,12 @@
 #include "publisher.hpp"
 
 #include <poll.h>
-#include <systemd/sd-daemon.h>
 
 #include <cmath>
 #include <limits>
 
 #include "realtime.hpp"
+#include "service_notify.hpp"
 #include "trajroi/host/clock.hpp"
 #include "trajroi/pipeline/pose_words.hpp"
 #include "trajroi/status_t.hpp"
@@ -161,7 +161,7 @@ void Publisher::publish_status(const StatusSnapshot& s) {
       m.trajectory_id, recording_text());
   say(lines);
   sweep_warnings_.flush(host::monotonic_ns());
-  if (!s.final) sd_notify(0, ("STATUS=" + health_.state()).c_str());
+  if (!s.final) (void)notify_service("STATUS=" + health_.state());
   latency_.end_window();
   last_status_ = s;
   minute_.on_status(s, latency_);

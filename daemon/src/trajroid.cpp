@@ -1,10 +1,10 @@
-// The wiring: sources, rings and threads, signals, sd_notify and the watchdog, the summary.
+// The wiring: sources, rings and threads, signals, the service manager's notifications and
+// watchdog, the summary.
 #include "trajroid.hpp"
 
 #include <poll.h>
 #include <signal.h>
 #include <sys/signalfd.h>
-#include <systemd/sd-daemon.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -21,6 +21,7 @@
 #include "publisher.hpp"
 #include "realtime.hpp"
 #include "reload.hpp"
+#include "service_notify.hpp"
 #include "threads.hpp"
 #include "trajroi/configure/receiver_config.hpp"
 #include "trajroi/inputs/live_input.hpp"
@@ -224,11 +225,13 @@ int run_pipeline(Pipeline& pipeline, pipeline::SweepProcessor& processor, Outlet
   if (pipeline.corrections) threads.emplace_back([&] { pipeline.corrections->run(pipeline.stop); });
   for (const auto& lane : pipeline.inputs)
     threads.emplace_back([&pipeline, &lane] { input_loop(pipeline, *lane); });
-  sd_notify(0, "READY=1\nSTATUS=running");
+  (void)notify_service("READY=1\nSTATUS=running");
 
-  std::uint64_t watchdog_usec = 0;
-  const bool watchdog = sd_watchdog_enabled(0, &watchdog_usec) > 0;
-  const int wait_ms = watchdog ? static_cast<int>(std::max<std::uint64_t>(watchdog_usec / 4000, 10)) : 1000;
+  if (!service_notifier().problem().empty())
+    log::warn("{}: the service manager is not told", service_notifier().problem());
+  const std::uint64_t watchdog_interval_usec = watchdog_usec();
+  const bool watchdog = watchdog_interval_usec > 0;
+  const int wait_ms = watchdog ? static_cast<int>(std::max<std::uint64_t>(watchdog_interval_usec / 4000, 10)) : 1000;
   std::uint64_t last_processing = 0, last_publishing = 0;
   for (;;) {
     pollfd fds[2] = {{sfd, POLLIN, 0}, {pipeline.main_wake.fd(), POLLIN, 0}};
@@ -242,7 +245,7 @@ int run_pipeline(Pipeline& pipeline, pipeline::SweepProcessor& processor, Outlet
           reloader.request();
         } else {
           log::info("{}: stopping", info.ssi_signo == SIGTERM ? "SIGTERM" : "SIGINT");
-          sd_notify(0, "STOPPING=1");
+          (void)notify_service("STOPPING=1");
           pipeline.stop.store(true);
         }
       }
@@ -252,7 +255,7 @@ int run_pipeline(Pipeline& pipeline, pipeline::SweepProcessor& processor, Outlet
       // Fed only while both the processing and the publishing loops turn.
       const std::uint64_t a = pipeline.processing_beat.load(std::memory_order_relaxed);
       const std::uint64_t b = pipeline.publishing_beat.load(std::memory_order_relaxed);
-      if (a != last_processing && b != last_publishing) sd_notify(0, "WATCHDOG=1");
+      if (a != last_processing && b != last_publishing) (void)notify_service("WATCHDOG=1");
       last_processing = a;
       last_publishing = b;
     }
