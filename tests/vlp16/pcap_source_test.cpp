@@ -338,6 +338,57 @@ TEST(Vlp16PcapSource, ClassicCapturesAreReadInPlaceAsLibpcapReadsThem) {
 // A capture another program truncates while it is replayed: the records read before (one
 // read of the reader's buffer, 512 KiB and a few bytes) are delivered, then a read error that says
 // so, neither a crash nor a quiet end; a capture read afterwards reads as before.
+// trajroid's recordings: written without libpcap in the classic format libpcap writes (its
+// ns magic, version 2.4, snap length 65535, Ethernet), read by libpcap (a stream, through a
+// pipe) as by the reader in place, each datagram as written (payload, time, port, sender).
+TEST(Vlp16PcapSource, ARecordingIsTheClassicPcapFileLibpcapReads) {
+  const auto path = std::filesystem::path(testing::TempDir()) / "trajroi_recorded.pcap";
+  const std::vector<std::uint8_t> data(1206, 0x5A), position(512, 0xA5);
+  {
+    PcapWriter writer(path);
+    writer.write(1'700'000'000'123'456'789, kDataPort, data);
+    writer.write(1'700'000'000'223'456'789, kPositionPort, position, std::uint64_t{0x7F000002} << 16 | 40000);
+    writer.close();
+  }
+  const std::string bytes = test::read_file(path);
+  ASSERT_GE(bytes.size(), 24u);
+  EXPECT_EQ(get32(bytes, 0), 0xA1B23C4Du);
+  EXPECT_EQ(bytes.substr(4, 4), std::string("\x02\x00\x04\x00", 4));
+  EXPECT_EQ(get32(bytes, 16), 65535u);
+  EXPECT_EQ(get32(bytes, 20), 1u);
+  ASSERT_EQ(record_offsets(bytes).size(), 2u);
+  EXPECT_EQ(bytes.size(), 24u + 2 * (16 + 42) + 1206 + 512);
+  expect_read_in_place_as_libpcap_reads(bytes, "a recording");
+
+  PcapSource source(path);
+  Datagram d;
+  ASSERT_EQ(source.next(d), PacketSource::Next::kDatagram) << source.error();
+  EXPECT_EQ(d.receive_time_ns, 1'700'000'000'123'456'789);
+  EXPECT_EQ(d.destination_port, kDataPort);
+  EXPECT_EQ(d.sender, std::uint64_t{0xC0A801C9} << 16 | kDataPort);  // the factory address
+  EXPECT_TRUE(std::equal(data.begin(), data.end(), d.payload.begin(), d.payload.end()));
+  ASSERT_EQ(source.next(d), PacketSource::Next::kDatagram) << source.error();
+  EXPECT_EQ(d.receive_time_ns, 1'700'000'000'223'456'789);
+  EXPECT_EQ(d.destination_port, kPositionPort);
+  EXPECT_EQ(d.sender, std::uint64_t{0x7F000002} << 16 | 40000);
+  EXPECT_TRUE(std::equal(position.begin(), position.end(), d.payload.begin(), d.payload.end()));
+  EXPECT_EQ(source.next(d), PacketSource::Next::kEnd);
+  std::filesystem::remove(path);
+}
+
+// A recording that cannot be created or written says which file.
+TEST(Vlp16PcapSource, ARecordingThatCannotBeWrittenIsNamed) {
+  try {
+    PcapWriter writer("/nonexistent-dir/lidar.pcap");
+    FAIL() << "created";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent-dir/lidar.pcap: cannot create"), std::string::npos) << e.what();
+  }
+  PcapWriter full("/dev/full");
+  full.write(1, kDataPort, std::vector<std::uint8_t>(1206, 1));
+  EXPECT_THROW(full.close(), std::runtime_error);
+}
+
 TEST(Vlp16PcapSource, ACaptureTruncatedWhileItIsReadIsAReadErrorNotACrash) {
   TRAJROI_REQUIRE_DATA(path, "velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap");
   // The capture's records three times over: longer than two reads.

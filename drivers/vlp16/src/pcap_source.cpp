@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "libpcap.hpp"
 #include "trajroi/host/memory.hpp"
 
 namespace trajroi::vlp16 {
@@ -231,12 +232,12 @@ struct ClassicPcap {
 };
 
 struct PcapSource::Handle {
-  pcap_t* pcap = nullptr;
+  pcap_t* pcap = nullptr;          // opened through libpcap() (loaded at the first stream)
   std::unique_ptr<char[]> buffer;  // the capture FILE's (glibc ignores a size without one)
   bool in_place = false;           // a classic pcap file: read by `classic`, not by libpcap
   ClassicPcap classic;
   ~Handle() {
-    if (pcap != nullptr) pcap_close(pcap);  // closes the FILE before its buffer goes
+    if (pcap != nullptr) libpcap().close(pcap);  // closes the FILE before its buffer goes
   }
 };
 
@@ -256,6 +257,11 @@ PcapSource::PcapSource(const std::filesystem::path& path, PcapOptions options)
     link_type_ = handle_->classic.link_type;
   }
   if (!handle_->in_place) {
+    const Libpcap& pcap = libpcap();
+    if (!pcap.error.empty()) {
+      (void)::close(fd);
+      throw std::runtime_error(path.string() + ": cannot open capture: " + pcap.error);
+    }
     std::FILE* file = fdopen(fd, "rb");
     if (file == nullptr) {
       const int error = errno;
@@ -265,12 +271,12 @@ PcapSource::PcapSource(const std::filesystem::path& path, PcapOptions options)
     handle_->buffer = std::make_unique_for_overwrite<char[]>(kReadBufferBytes);
     (void)std::setvbuf(file, handle_->buffer.get(), _IOFBF, kReadBufferBytes);  // the default buffer if refused
     char message[PCAP_ERRBUF_SIZE] = {};
-    handle_->pcap = pcap_fopen_offline_with_tstamp_precision(file, PCAP_TSTAMP_PRECISION_NANO, message);
+    handle_->pcap = pcap.fopen_offline_with_tstamp_precision(file, PCAP_TSTAMP_PRECISION_NANO, message);
     if (handle_->pcap == nullptr) {
       (void)std::fclose(file);  // pcap_close() closes it once the capture is open
       throw std::runtime_error(path.string() + ": cannot open capture: " + message);
     }
-    link_type_ = pcap_datalink(handle_->pcap);
+    link_type_ = pcap.datalink(handle_->pcap);
   }
   if (link_type_ != kLinkEthernet && link_type_ != kLinkSll && link_type_ != kLinkSll2 && link_type_ != kLinkRaw &&
       link_type_ != kLinkRawAlt && link_type_ != kLinkIpv4) {
@@ -288,10 +294,10 @@ PcapSource::Next PcapSource::next(Datagram& datagram, std::chrono::milliseconds 
 PcapSource::Next PcapSource::next_record(const std::uint8_t*& frame, std::size_t& length, std::int64_t& time_ns) {
   if (handle_->in_place) return handle_->classic.next(frame, length, time_ns, error_);
   pcap_pkthdr* header = nullptr;
-  const int status = pcap_next_ex(handle_->pcap, &header, &frame);
+  const int status = libpcap().next_ex(handle_->pcap, &header, &frame);
   if (status == PCAP_ERROR_BREAK) return Next::kEnd;
   if (status != 1) {
-    error_ = pcap_geterr(handle_->pcap);
+    error_ = libpcap().geterr(handle_->pcap);
     return Next::kError;
   }
   length = header->caplen;
