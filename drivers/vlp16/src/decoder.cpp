@@ -127,11 +127,7 @@ const PacketDecoder::StepTables& PacketDecoder::step_tables(Model model) {
 }
 
 PacketDecoder::PacketDecoder(const Calibration& calibration, DecodeOptions options, Model model)
-    : model_(model),
-      options_(options),
-      distance_unit_m_(spec(model).distance_unit_m),
-      azimuth_table_(azimuth_table()),
-      step_tables_(step_tables(model)) {
+    : model_(model), options_(options), distance_unit_m_(spec(model).distance_unit_m) {
   const ModelSpec& s = spec(model);
   if (calibration.laser_count != s.lasers) {
     throw std::invalid_argument("a calibration of " + std::to_string(calibration.laser_count) + " lasers for the " +
@@ -163,12 +159,12 @@ PacketDecoder::PacketDecoder(const Calibration& calibration, DecodeOptions optio
 }
 
 // Inlined into both builds of decode (below).
-__attribute__((always_inline)) inline void PacketDecoder::directions(std::uint16_t azimuth, std::uint32_t gap,
-                                                                     Directions& d) const noexcept {
+__attribute__((always_inline)) inline void PacketDecoder::directions(const Tables& tables, std::uint16_t azimuth,
+                                                                     std::uint32_t gap, Directions& d) const noexcept {
   if (gap <= kSeriesGapLimit_cdeg && azimuth < kAzimuthLimit) {
-    const CosSin base = azimuth_table_.azimuth[azimuth];
-    const auto& step_cos = step_tables_.step_cos[gap];
-    const auto& step_sin = step_tables_.step_sin[gap];
+    const CosSin base = tables.azimuth.azimuth[azimuth];
+    const auto& step_cos = tables.steps.step_cos[gap];
+    const auto& step_sin = tables.steps.step_sin[gap];
     for (std::size_t channel = 0; channel < kChannels; ++channel) {
       d.cos_a[channel] = base.c * step_cos[channel] - base.s * step_sin[channel];
       d.sin_a[channel] = base.s * step_cos[channel] + base.c * step_sin[channel];
@@ -294,6 +290,8 @@ __attribute__((always_inline)) inline PacketDecoder::Result PacketDecoder::decod
   const double min_range = options_.min_range_m;
   const double max_range = options_.max_range_m;
   Directions d;
+  // Built at the first packet of the model (a model never heard costs nothing at start).
+  const Tables tables{azimuth_table(), step_tables(model_)};
   const std::size_t points_before = out.size();
   // The firings' entries lie a few hundred bytes apart in the 576 KB azimuth table, a new
   // cache line each and seldom cached: all asked for at once, their misses overlap instead of
@@ -301,7 +299,7 @@ __attribute__((always_inline)) inline PacketDecoder::Result PacketDecoder::decod
   // the decoding's profile samples 83 → 68 ms, medians of 4 runs each; the same points).
   for (std::size_t block = 0; block < kBlocks; block += step) {
     const std::uint16_t azimuth = block_azimuth(packet, block);
-    if (azimuth < kAzimuthLimit) __builtin_prefetch(&azimuth_table_.azimuth[azimuth]);
+    if (azimuth < kAzimuthLimit) __builtin_prefetch(&tables.azimuth.azimuth[azimuth]);
   }
 
   for (std::size_t block = 0; block < kBlocks; block += step) {
@@ -310,7 +308,7 @@ __attribute__((always_inline)) inline PacketDecoder::Result PacketDecoder::decod
     // the packet's last firing, the advance over the previous one.
     const std::uint32_t gap = block + step < kBlocks ? azimuth_gap(azimuth, block_azimuth(packet, block + step))
                                                      : azimuth_gap(block_azimuth(packet, block - step), azimuth);
-    directions(azimuth, gap, d);
+    directions(tables, azimuth, gap, d);
     const auto& time_ns = time_ns_[block / step];
     widen_azimuth_bounds(d.azimuth_deg, result.azimuth_min_deg, result.azimuth_max_deg);
     result.time_offset_max_ns = std::max(result.time_offset_max_ns, time_ns[kChannels - 1]);

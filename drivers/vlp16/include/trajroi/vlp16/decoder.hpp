@@ -167,21 +167,23 @@ class PacketDecoder {
     std::array<double, kFiringsPerBlock * kLasers> cos_a, sin_a;
     std::array<float, kFiringsPerBlock * kLasers> azimuth_deg;
   };
-  // The directions of the channels of a block at `azimuth`, advancing by `gap` over it, in
-  // loops without branches (the compiler vectorizes them).
-  void directions(std::uint16_t azimuth, std::uint32_t gap, Directions& d) const noexcept;
-  Result decode_body(std::span<const std::uint8_t> packet, std::vector<Point>& out) const;
   struct AzimuthTable;
   struct StepTables;
-  // Built at the first call, then shared: the azimuths' cos/sin by every decoder, the in-block
-  // steps by the decoders of one model.
+  struct Tables {
+    const AzimuthTable& azimuth;
+    const StepTables& steps;
+  };
+  // The directions of the channels of a block at `azimuth`, advancing by `gap` over it, in
+  // loops without branches (the compiler vectorizes them).
+  void directions(const Tables& tables, std::uint16_t azimuth, std::uint32_t gap, Directions& d) const noexcept;
+  Result decode_body(std::span<const std::uint8_t> packet, std::vector<Point>& out) const;
+  // Built at the first call (the first packet decoded: thread-safe), then shared: the azimuths'
+  // cos/sin by every decoder, the in-block steps by the decoders of one model.
   [[nodiscard]] static const AzimuthTable& azimuth_table();
   [[nodiscard]] static const StepTables& step_tables(Model model);
   Model model_;
   DecodeOptions options_;
   double distance_unit_m_;
-  const AzimuthTable& azimuth_table_;
-  const StepTables& step_tables_;
   std::array<Laser, kMaxLasers> lasers_{};
   std::array<std::uint8_t, kFiringsPerBlock * kLasers> channel_laser_{};  // per channel of a block
   bool rotation_corrected_ = false;                                       // some rot_correction ≠ 0
