@@ -5,14 +5,13 @@
 // ends the process abnormally so that Restart=on-failure starts it again; the new instance must
 // come up and feed the watchdog.
 #include <gtest/gtest.h>
-#include <sys/socket.h>
-#include <sys/un.h>
 
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "daemon_fixture.hpp"
+#include "notify_socket.hpp"
 
 namespace {
 
@@ -23,37 +22,7 @@ using std::chrono::seconds;
 
 constexpr auto kWatchdog = milliseconds(1000);
 
-class NotifySocket {
- public:
-  NotifySocket() : path_(fs::temp_directory_path() / ("trajroid_notify_" + std::to_string(::getpid()) + ".sock")) {
-    fs::remove(path_);
-    fd_ = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-    sockaddr_un a{};
-    a.sun_family = AF_UNIX;
-    std::snprintf(a.sun_path, sizeof a.sun_path, "%s", path_.c_str());
-    bound_ = fd_ >= 0 && bind(fd_, reinterpret_cast<const sockaddr*>(&a), sizeof a) == 0;
-    timeval tv{0, 20'000};
-    (void)setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-  }
-  ~NotifySocket() {
-    if (fd_ >= 0) close(fd_);
-    fs::remove(path_);
-  }
-  [[nodiscard]] bool bound() const { return bound_; }
-  [[nodiscard]] std::string environment() const { return "NOTIFY_SOCKET=" + path_.string(); }
-  // One notification, or nothing within 20 ms.
-  std::optional<std::string> receive() {
-    char buffer[4096];
-    const ssize_t n = recv(fd_, buffer, sizeof buffer, 0);
-    if (n <= 0) return std::nullopt;
-    return std::string(buffer, static_cast<std::size_t>(n));
-  }
-
- private:
-  fs::path path_;
-  int fd_ = -1;
-  bool bound_ = false;
-};
+using test_notify::NotifySocket;
 
 bool has_line(const std::string& message, const std::string& line) {
   std::istringstream in(message);
@@ -102,7 +71,9 @@ double seconds_of(Clock::duration d) {
 }
 
 TEST(TrajroidWatchdog, AStuckProcessingThreadStopsTheWatchdogAndTheServiceIsRestarted) {
-  NotifySocket notify;
+  NotifySocket notify(
+      (fs::temp_directory_path() / ("trajroid_notify_" + std::to_string(::getpid()) + ".sock")).string(),
+      std::chrono::milliseconds(20));
   ASSERT_TRUE(notify.bound());
   const fs::path dir = corridor_run();
   const std::vector<std::string> args{

@@ -6,59 +6,26 @@
 #include "service_notify.hpp"
 
 #include <gtest/gtest.h>
-#include <sys/socket.h>
-#include <sys/un.h>
 #include <unistd.h>
 
-#include <cstddef>
+#include <chrono>
 #include <cstdint>
-#include <cstdio>
-#include <cstring>
 #include <optional>
 #include <string>
+
+#include "notify_socket.hpp"
 
 namespace {
 
 using trajroi::daemon::ServiceNotifier;
 using trajroi::daemon::watchdog_usec;
 
-// A datagram socket bound to `name` (a path, or '@' and an abstract name).
-class Receiver {
- public:
-  explicit Receiver(const std::string& name) : name_(name) {
-    fd_ = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-    sockaddr_un a{};
-    a.sun_family = AF_UNIX;
-    std::memcpy(a.sun_path, name.data(), name.size());
-    if (name.front() == '@') a.sun_path[0] = '\0';
-    const auto length = static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + name.size());
-    bound_ = fd_ >= 0 && bind(fd_, reinterpret_cast<const sockaddr*>(&a), length) == 0;
-    timeval tv{1, 0};
-    (void)setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-  }
-  ~Receiver() {
-    if (fd_ >= 0) close(fd_);
-    if (name_.front() == '/') (void)std::remove(name_.c_str());
-  }
-  Receiver(const Receiver&) = delete;
-  Receiver& operator=(const Receiver&) = delete;
-  [[nodiscard]] bool bound() const { return bound_; }
-  std::optional<std::string> receive() {
-    char buffer[4096];
-    const ssize_t n = recv(fd_, buffer, sizeof buffer, 0);
-    if (n <= 0) return std::nullopt;
-    return std::string(buffer, static_cast<std::size_t>(n));
-  }
-
- private:
-  std::string name_;
-  int fd_ = -1;
-  bool bound_ = false;
-};
+using test_notify::NotifySocket;
+constexpr auto kWait = std::chrono::seconds(1);
 
 TEST(ServiceNotify, TheStateReachesASocketNamedByAPath) {
-  const std::string path = "/tmp/trajroi_notify_test_" + std::to_string(getpid()) + ".sock";
-  Receiver receiver(path);
+  const std::string path = ::testing::TempDir() + "trajroi_notify_test_" + std::to_string(getpid()) + ".sock";
+  NotifySocket receiver(path, kWait);
   ASSERT_TRUE(receiver.bound());
   const ServiceNotifier notifier(path.c_str());
   EXPECT_TRUE(notifier.problem().empty());
@@ -70,7 +37,7 @@ TEST(ServiceNotify, TheStateReachesASocketNamedByAPath) {
 
 TEST(ServiceNotify, TheStateReachesASocketWithAnAbstractName) {
   const std::string name = "@trajroi/notify-test/" + std::to_string(getpid());
-  Receiver receiver(name);
+  NotifySocket receiver(name, kWait);
   ASSERT_TRUE(receiver.bound());
   const ServiceNotifier notifier(name.c_str());
   EXPECT_TRUE(notifier.notify("STATUS=tracking"));
@@ -92,7 +59,8 @@ TEST(ServiceNotify, WithoutASocketThereIsNothingToDoAndABadOneIsSaid) {
   EXPECT_FALSE(too_long.notify("READY=1"));
   EXPECT_NE(too_long.problem().find("longer than"), std::string::npos) << too_long.problem();
   // A socket nobody listens on: the send fails, nothing else happens.
-  const ServiceNotifier nobody("/tmp/trajroi_notify_test_nobody.sock");
+  const std::string nobody_path = ::testing::TempDir() + "trajroi_notify_nobody_" + std::to_string(getpid()) + ".sock";
+  const ServiceNotifier nobody(nobody_path.c_str());
   EXPECT_FALSE(nobody.notify("READY=1"));
 }
 
