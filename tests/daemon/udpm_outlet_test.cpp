@@ -174,6 +174,17 @@ TEST(UdpmOutlet, AnInputOverLcmLeavesOutTheOutletsDatagramsAndHearsOthers) {
 
 namespace {
 
+// A socket closed when the test leaves, by any path.
+struct Socket {
+  int fd;
+  explicit Socket(int f) : fd(f) {}
+  Socket(const Socket&) = delete;
+  Socket& operator=(const Socket&) = delete;
+  ~Socket() {
+    if (fd >= 0) close(fd);
+  }
+};
+
 // The UDP checksum field of the next datagram to `port` a raw socket sees, or -1.
 int next_checksum_to(int raw, int port, std::chrono::milliseconds timeout) {
   const auto end = std::chrono::steady_clock::now() + timeout;
@@ -196,8 +207,8 @@ int next_checksum_to(int raw, int port, std::chrono::milliseconds timeout) {
 TEST(UdpmOutlet, DatagramsThatStayOnThisMachineGoWithoutAUdpChecksum) {
   // ttl 0: the kernel then copies the messages without summing them. Seen on the wire by a raw
   // socket, against a plain socket's datagram to the same group, which carries a checksum.
-  const int raw = socket(AF_INET, SOCK_RAW | SOCK_CLOEXEC, IPPROTO_UDP);
-  if (raw < 0) GTEST_SKIP() << "a raw socket needs CAP_NET_RAW (run as root): " << std::strerror(errno);
+  const Socket raw(socket(AF_INET, SOCK_RAW | SOCK_CLOEXEC, IPPROTO_UDP));
+  if (raw.fd < 0) GTEST_SKIP() << "a raw socket needs CAP_NET_RAW (run as root): " << std::strerror(errno);
   const int port = free_port();
   const std::string url = "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0";
   const auto group = trajroi::daemon::lcm_multicast_group(url);
@@ -207,21 +218,19 @@ TEST(UdpmOutlet, DatagramsThatStayOnThisMachineGoWithoutAUdpChecksum) {
   // A member of the group on this host, so that its datagrams are delivered here.
   ASSERT_TRUE(outlet.subscribe("OTHER", [](std::span<const std::uint8_t>, const std::string&) {}));
 
-  const int plain = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  const Socket plain(socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0));
   const unsigned char ttl = 0;
-  ASSERT_EQ(setsockopt(plain, IPPROTO_IP, IP_MULTICAST_TTL, &ttl, sizeof ttl), 0);
+  ASSERT_EQ(setsockopt(plain.fd, IPPROTO_IP, IP_MULTICAST_TTL, &ttl, sizeof ttl), 0);
   sockaddr_in to{};
   to.sin_family = AF_INET;
   to.sin_port = htons(static_cast<std::uint16_t>(port));
   inet_pton(AF_INET, "239.255.76.67", &to.sin_addr);
   const char text[] = "a datagram with its checksum";
-  ASSERT_GT(sendto(plain, text, sizeof text, 0, reinterpret_cast<sockaddr*>(&to), sizeof to), 0);
-  close(plain);
-  const int plain_checksum = next_checksum_to(raw, port, std::chrono::seconds(2));
+  ASSERT_GT(sendto(plain.fd, text, sizeof text, 0, reinterpret_cast<sockaddr*>(&to), sizeof to), 0);
+  const int plain_checksum = next_checksum_to(raw.fd, port, std::chrono::seconds(2));
   ASSERT_NE(plain_checksum, -1) << "the raw socket saw no datagram to the group";
   EXPECT_NE(plain_checksum, 0);
 
   outlet.publish("CHANNEL", bytes_of(100, 5));
-  EXPECT_EQ(next_checksum_to(raw, port, std::chrono::seconds(2)), 0);
-  close(raw);
+  EXPECT_EQ(next_checksum_to(raw.fd, port, std::chrono::seconds(2)), 0);
 }
