@@ -16,6 +16,7 @@
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -43,6 +44,31 @@ std::vector<std::uint8_t> bytes_of(std::size_t n, std::uint8_t seed) {
   for (std::size_t i = 0; i < n; ++i)
     v[i] = static_cast<std::uint8_t>(i * 31 + seed);
   return v;
+}
+
+// A socket closed when the test leaves, by any path.
+struct Socket {
+  int fd;
+  explicit Socket(int f) : fd(f) {}
+  Socket(const Socket&) = delete;
+  Socket& operator=(const Socket&) = delete;
+  ~Socket() {
+    if (fd >= 0) close(fd);
+  }
+};
+
+// One datagram to the group on `port`, TTL 0, from a plain socket (neither liblcm's nor the
+// outlet's): whether it was sent.
+bool send_to_group(int port, std::string_view text) {
+  const Socket plain(socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0));
+  const unsigned char ttl = 0;
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(static_cast<std::uint16_t>(port));
+  inet_pton(AF_INET, "239.255.76.67", &to.sin_addr);
+  return setsockopt(plain.fd, IPPROTO_IP, IP_MULTICAST_TTL, &ttl, sizeof ttl) == 0 &&
+         sendto(plain.fd, text.data(), text.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to) ==
+             static_cast<ssize_t>(text.size());
 }
 
 // Runs `outlet`'s incoming handling until `done` or `timeout`.
@@ -122,16 +148,8 @@ TEST(UdpmOutlet, TalksWithLiblcmBothWaysAndNeverReadsItsOwnDatagrams) {
   UdpmOutlet second(url, *group);
   Received second_got;
   ASSERT_TRUE(second.subscribe("IN", keep(second_got)));
-  const int raw = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  sockaddr_in to{};
-  to.sin_family = AF_INET;
-  to.sin_port = htons(static_cast<std::uint16_t>(port));
-  inet_pton(AF_INET, "239.255.76.67", &to.sin_addr);
-  const unsigned char ttl = 0;
-  setsockopt(raw, IPPROTO_IP, IP_MULTICAST_TTL, &ttl, sizeof ttl);
-  const char garbage[] = "LC03 not really a fragment";
-  ASSERT_GT(sendto(raw, garbage, sizeof garbage, 0, reinterpret_cast<sockaddr*>(&to), sizeof to), 0);
-  close(raw);
+  constexpr char kGarbage[] = "LC03 not really a fragment";
+  ASSERT_TRUE(send_to_group(port, std::string_view(kGarbage, sizeof kGarbage)));
   outlet.publish("IN", small);
   pump(
       second, [&] { return !second_got.empty(); }, std::chrono::seconds(3));
@@ -174,17 +192,6 @@ TEST(UdpmOutlet, AnInputOverLcmLeavesOutTheOutletsDatagramsAndHearsOthers) {
 
 namespace {
 
-// A socket closed when the test leaves, by any path.
-struct Socket {
-  int fd;
-  explicit Socket(int f) : fd(f) {}
-  Socket(const Socket&) = delete;
-  Socket& operator=(const Socket&) = delete;
-  ~Socket() {
-    if (fd >= 0) close(fd);
-  }
-};
-
 // The UDP checksum field of the next datagram to `port` a raw socket sees, or -1.
 int next_checksum_to(int raw, int port, std::chrono::milliseconds timeout) {
   const auto end = std::chrono::steady_clock::now() + timeout;
@@ -218,15 +225,7 @@ TEST(UdpmOutlet, DatagramsThatStayOnThisMachineGoWithoutAUdpChecksum) {
   // A member of the group on this host, so that its datagrams are delivered here.
   ASSERT_TRUE(outlet.subscribe("OTHER", [](std::span<const std::uint8_t>, const std::string&) {}));
 
-  const Socket plain(socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0));
-  const unsigned char ttl = 0;
-  ASSERT_EQ(setsockopt(plain.fd, IPPROTO_IP, IP_MULTICAST_TTL, &ttl, sizeof ttl), 0);
-  sockaddr_in to{};
-  to.sin_family = AF_INET;
-  to.sin_port = htons(static_cast<std::uint16_t>(port));
-  inet_pton(AF_INET, "239.255.76.67", &to.sin_addr);
-  const char text[] = "a datagram with its checksum";
-  ASSERT_GT(sendto(plain.fd, text, sizeof text, 0, reinterpret_cast<sockaddr*>(&to), sizeof to), 0);
+  ASSERT_TRUE(send_to_group(port, "a datagram with its checksum"));
   const int plain_checksum = next_checksum_to(raw.fd, port, std::chrono::seconds(2));
   ASSERT_NE(plain_checksum, -1) << "the raw socket saw no datagram to the group";
   EXPECT_NE(plain_checksum, 0);

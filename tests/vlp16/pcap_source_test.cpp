@@ -335,9 +335,6 @@ TEST(Vlp16PcapSource, ClassicCapturesAreReadInPlaceAsLibpcapReadsThem) {
   std::filesystem::remove(empty);
 }
 
-// A capture another program truncates while it is replayed: the records read before (one
-// read of the reader's buffer, 512 KiB and a few bytes) are delivered, then a read error that says
-// so, neither a crash nor a quiet end; a capture read afterwards reads as before.
 // The message of the std::runtime_error `f` throws ("" when it throws none: a failed find).
 template <typename F>
 std::string error_of(F f) {
@@ -396,6 +393,9 @@ TEST(Vlp16PcapSource, ARecordingThatCannotBeWrittenIsNamed) {
   EXPECT_THROW(full.close(), std::runtime_error);
 }
 
+// A capture another program truncates while it is replayed: the records read before (one
+// read of the reader's buffer, 512 KiB and a few bytes) are delivered, then a read error that says
+// so, neither a crash nor a quiet end; a capture read afterwards reads as before.
 TEST(Vlp16PcapSource, ACaptureTruncatedWhileItIsReadIsAReadErrorNotACrash) {
   TRAJROI_REQUIRE_DATA(path, "velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap");
   // The capture's records three times over: longer than two reads.
