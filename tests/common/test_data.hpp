@@ -1,6 +1,7 @@
 #pragma once
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -30,6 +31,12 @@ inline std::string read_file(const std::filesystem::path& path) {
   in.seekg(0);
   in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   return bytes;
+}
+
+// A path in the test's temporary folder that no other test process uses: ctest runs tests in
+// parallel, each in its own process, so a fixed name would be shared between them.
+inline std::filesystem::path scratch_path(std::string_view name) {
+  return std::filesystem::path(::testing::TempDir()) / (std::to_string(::getpid()) + "_" + std::string(name));
 }
 
 }  // namespace trajroi::test

@@ -228,7 +228,7 @@ TEST(ReceiverConfig, AVn100RegisterIsWrittenAndReadBack) {
 
 TEST(ReceiverConfig, TheConfigureCommandReportsAndExitsByTheOutcome) {
   ScriptedDevice f9(ublox_device([](auto, auto, auto) { return 1; }));
-  const std::string out = ::testing::TempDir() + "configure_cli.txt";
+  const std::string out = ::testing::TempDir() + "configure_cli_" + std::to_string(getpid()) + ".txt";
   int status = std::system(
       (std::string(TRAJROI_CLI) + " configure gnss --device " + f9.path() + " --rate 10 > " + out + " 2>&1").c_str());
   EXPECT_EQ(WEXITSTATUS(status), 0);

@@ -3,9 +3,11 @@
 // the same bytes datagram for datagram.
 #include "trajroi/vlp16/pcap_source.hpp"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
@@ -35,7 +37,7 @@ TEST(Vlp16PcapSource, TruncatedCaptureDeliversEveryWholeRecordThenAnError) {
     std::memcpy(&captured, bytes.data() + at + 8, 4);
     at += 16 + captured;
   }
-  const auto cut = std::filesystem::path(testing::TempDir()) / "trajroi_truncated.pcap";
+  const auto cut = test::scratch_path("trajroi_truncated.pcap");
   {
     std::ofstream out(cut, std::ios::binary);
     out.write(bytes.data(), static_cast<std::streamsize>(at + 500));
@@ -171,7 +173,7 @@ TEST(Vlp16PcapSource, EveryLinkTypeYieldsTheSameDatagram) {
       {"IPv4", 228, {other, data}},
   };
   for (const Case& c : cases) {
-    const auto path = std::filesystem::path(testing::TempDir()) / "trajroi_link.pcap";
+    const auto path = test::scratch_path("trajroi_link.pcap");
     write_pcap(path, c.link, c.frames);
     PcapSource source(path);
     Datagram datagram;
@@ -185,7 +187,7 @@ TEST(Vlp16PcapSource, EveryLinkTypeYieldsTheSameDatagram) {
     std::filesystem::remove(path);
   }
   // A link type it does not read is refused by name.
-  const auto path = std::filesystem::path(testing::TempDir()) / "trajroi_link.pcap";
+  const auto path = test::scratch_path("trajroi_link.pcap");
   write_pcap(path, 105, {});  // IEEE 802.11
   EXPECT_THROW(PcapSource{path}, std::runtime_error);
   std::filesystem::remove(path);
@@ -218,8 +220,8 @@ Seen read_capture(const std::filesystem::path& from) {
 // `bytes` as a regular file (mapped: a classic pcap file is read in place by trajroi) and
 // through a pipe (read as a stream by libpcap), which must agree datagram for datagram.
 void expect_read_in_place_as_libpcap_reads(const std::string& bytes, const std::string& what) {
-  const auto file = std::filesystem::path(testing::TempDir()) / "trajroi_capture.pcap";
-  const auto fifo = std::filesystem::path(testing::TempDir()) / "trajroi_capture.fifo";
+  const auto file = test::scratch_path("trajroi_capture.pcap");
+  const auto fifo = test::scratch_path("trajroi_capture.fifo");
   {
     std::ofstream out(file, std::ios::binary);
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
@@ -237,7 +239,16 @@ void expect_read_in_place_as_libpcap_reads(const std::string& bytes, const std::
     std::ofstream out(fifo, std::ios::binary);
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   });
-  const Seen streamed = read_capture(fifo);
+  Seen streamed;
+  try {
+    streamed = read_capture(fifo);
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << what << ": reading through the pipe threw: " << e.what();
+    // A writer still waiting for a reader to open the pipe is released (then meets EPIPE), so
+    // that it is joined on every path.
+    const int release = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+    if (release >= 0) ::close(release);
+  }
   writer.join();
   sigaction(SIGPIPE, &before, nullptr);
   std::filesystem::remove(fifo);
@@ -322,14 +333,14 @@ TEST(Vlp16PcapSource, ClassicCapturesAreReadInPlaceAsLibpcapReadsThem) {
   put32(oversized, records[40] + 8, 300'000);
   expect_read_in_place_as_libpcap_reads(oversized, "a record over 262 144 bytes");
 
-  const auto not_capture = std::filesystem::path(testing::TempDir()) / "trajroi_not_capture.pcap";
+  const auto not_capture = test::scratch_path("trajroi_not_capture.pcap");
   {
     std::ofstream out(not_capture, std::ios::binary);
     out << "this is not a capture file, only text long enough to have a header";
   }
   EXPECT_THROW(PcapSource{not_capture}, std::runtime_error);
   std::filesystem::remove(not_capture);
-  const auto empty = std::filesystem::path(testing::TempDir()) / "trajroi_empty.pcap";
+  const auto empty = test::scratch_path("trajroi_empty.pcap");
   { std::ofstream out(empty, std::ios::binary); }
   EXPECT_THROW(PcapSource{empty}, std::runtime_error);
   std::filesystem::remove(empty);
@@ -350,7 +361,7 @@ std::string error_of(F f) {
 // ns magic, version 2.4, snap length 65535, Ethernet), read by libpcap (a stream, through a
 // pipe) as by the reader in place, each datagram as written (payload, time, port, sender).
 TEST(Vlp16PcapSource, ARecordingIsTheClassicPcapFileLibpcapReads) {
-  const auto path = std::filesystem::path(testing::TempDir()) / "trajroi_recorded.pcap";
+  const auto path = test::scratch_path("trajroi_recorded.pcap");
   const std::vector<std::uint8_t> data(1206, 0x5A), position(512, 0xA5);
   {
     PcapWriter writer(path);
@@ -412,7 +423,7 @@ TEST(Vlp16PcapSource, ACaptureTruncatedWhileItIsReadIsAReadErrorNotACrash) {
     at += 16 + captured;
     ++in_first_read;
   }
-  const auto copy = std::filesystem::path(testing::TempDir()) / "trajroi_shrinking.pcap";
+  const auto copy = test::scratch_path("trajroi_shrinking.pcap");
   for (int round = 0; round < 2; ++round) {
     {
       std::ofstream out(copy, std::ios::binary | std::ios::trunc);
