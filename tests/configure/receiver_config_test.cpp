@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "test_data.hpp"
 #include "trajroi/ublox/framer.hpp"
 #include "trajroi/ublox/messages.hpp"
 #include "trajroi/vn100/command.hpp"
@@ -228,7 +229,7 @@ TEST(ReceiverConfig, AVn100RegisterIsWrittenAndReadBack) {
 
 TEST(ReceiverConfig, TheConfigureCommandReportsAndExitsByTheOutcome) {
   ScriptedDevice f9(ublox_device([](auto, auto, auto) { return 1; }));
-  const std::string out = ::testing::TempDir() + "configure_cli_" + std::to_string(getpid()) + ".txt";
+  const std::string out = ::trajroi::test::scratch_path("configure_cli.txt").string();
   int status = std::system(
       (std::string(TRAJROI_CLI) + " configure gnss --device " + f9.path() + " --rate 10 > " + out + " 2>&1").c_str());
   EXPECT_EQ(WEXITSTATUS(status), 0);
