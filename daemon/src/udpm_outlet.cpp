@@ -39,10 +39,6 @@ UdpmOutlet::UdpmOutlet(const std::string& url, const LcmGroup& group)
     close(send_fd_);
     throw std::runtime_error("LCM: cannot open '" + url_ + "': " + why);
   }
-  // With ttl 0 the datagrams never leave this machine: sent without a UDP checksum, the
-  // kernel copies them without computing one.
-  const int no_check = 1;
-  if (group_.ttl == 0) (void)setsockopt(send_fd_, SOL_SOCKET, SO_NO_CHECK, &no_check, sizeof no_check);
   own_source_ = udpm_own_source(send_fd_, group_, 500);
 }
 
