@@ -243,6 +243,7 @@ TEST(ReceiverConfig, TheConfigureCommandReportsAndExitsByTheOutcome) {
   std::string text(4096, '\0');
   text.resize(std::fread(text.data(), 1, text.size(), f));
   std::fclose(f);
+  std::remove(out.c_str());
   EXPECT_NE(text.find("ok   CFG-VALSET (F9): NAV-PVT, NAV-HPPOSLLH at 10 Hz on UART1: ACK-ACK"), std::string::npos)
       << text;
   EXPECT_NE(text.find("FAIL CFG-RATE (M8): 5 Hz: no answer within 200 ms"), std::string::npos) << text;
