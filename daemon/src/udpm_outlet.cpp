@@ -9,6 +9,7 @@
 
 #include "outlet.hpp"
 #include "pipeline.hpp"
+#include "udpm_route.hpp"
 
 namespace trajroi::daemon {
 
@@ -40,6 +41,9 @@ UdpmOutlet::UdpmOutlet(const std::string& url, const LcmGroup& group)
     throw std::runtime_error("LCM: cannot open '" + url_ + "': " + why);
   }
   own_source_ = udpm_own_source(send_fd_, group_, 500);
+  if (const std::optional<UdpmRoute> route = udpm_route(group_)) {
+    if (const std::string advice = udpm_route_advice(url_, group_, *route); !advice.empty()) log::info("{}", advice);
+  }
 }
 
 UdpmOutlet::~UdpmOutlet() {

@@ -18,6 +18,7 @@
 
 #include "outlet.hpp"
 #include "trajroi/transport/lcm_subscribe.hpp"
+#include "udpm_route.hpp"
 
 namespace {
 
@@ -184,4 +185,34 @@ TEST(UdpmOutlet, AnInputOverLcmLeavesOutTheOutletsDatagramsAndHearsOthers) {
   }
   ASSERT_EQ(got.size(), 1u);
   EXPECT_EQ(got[0], (std::pair<std::string, std::vector<std::uint8_t>>{"POSE", theirs}));
+}
+
+// The start-up line about the group's route (its live test: tests/daemon/lcm_route_test.sh,
+// against the kernel's own fragment count in a network namespace).
+TEST(UdpmRoute, FragmentsPerDatagramAreThoseRfc791Cuts) {
+  using trajroi::daemon::udpm_fragments_per_datagram;
+  // 65 507 B of LCM datagram + 8 B of UDP header = 65 515 B; each fragment carries the MTU
+  // less the 20 B IP header, rounded down to a multiple of 8.
+  EXPECT_EQ(udpm_fragments_per_datagram(1500), 45);  // 1 480 B each: 44 of them hold 65 120
+  EXPECT_EQ(udpm_fragments_per_datagram(1400), 48);  // 1 376 B each: 47 hold 64 672
+  EXPECT_EQ(udpm_fragments_per_datagram(9000), 8);   // 8 976 B each: 7 hold 62 832
+  EXPECT_EQ(udpm_fragments_per_datagram(576), 119);  // 552 B each: 118 hold 65 136
+  EXPECT_EQ(udpm_fragments_per_datagram(65535), 1);  // 65 515 + 20 fits whole
+  EXPECT_EQ(udpm_fragments_per_datagram(65536), 1);  // lo
+}
+
+TEST(UdpmRoute, AdviceOnlyForAGroupKeptOnThisHostWhoseDatagramsAreFragmented) {
+  using trajroi::daemon::udpm_route_advice;
+  trajroi::daemon::LcmGroup group{"239.255.76.67", 7667, 0, 0};
+  const std::string url = "udpm://239.255.76.67:7667?ttl=0";
+  const std::string line = udpm_route_advice(url, group, {"eth0", 1500});
+  EXPECT_EQ(line.rfind("LCM " + url + ": ", 0), 0U) << line;
+  EXPECT_NE(line.find("route goes through eth0 (MTU 1500): each 64 KB datagram of a cloud is cut into 45 IP fragments"),
+            std::string::npos)
+      << line;
+  EXPECT_NE(line.find("ip link set lo multicast on; ip route add 239.255.76.67/32 dev lo"), std::string::npos) << line;
+  EXPECT_EQ(udpm_route_advice(url, group, {"lo", 65536}), "");
+  EXPECT_EQ(udpm_route_advice(url, group, {"lo", 65535}), "");
+  group.ttl = 1;  // meant to leave the host: its route is the network's business
+  EXPECT_EQ(udpm_route_advice("udpm://239.255.76.67:7667?ttl=1", group, {"eth0", 1500}), "");
 }

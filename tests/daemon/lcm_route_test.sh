@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# trajroid names, at start-up, a ttl=0 LCM group whose route cuts the clouds' datagrams into
+# IP fragments, with the interface, its MTU and the kernel's own count of fragments per
+# datagram (its FragCreates counter over one 65 507-byte datagram sent to the group), and says
+# nothing when the group goes over lo or is meant to leave the host (ttl=1). All in a network
+# namespace of its own: a veth pair of MTU 1 500 carries the group, then lo with a route of
+# mtu 1 400, then lo as it is.
+# Usage: lcm_route_test.sh TRAJROI TRAJROID SCENARIO WORK
+set -euo pipefail
+trajroi=$1 trajroid=$2 scenario=$3 work=$4
+if [ "$(id -u)" -ne 0 ] || ! command -v unshare >/dev/null || ! command -v ip >/dev/null; then
+  echo "lcm_route_test: needs root, unshare and ip" >&2
+  [ "${CI:-}" = true ] && exit 1
+  exit 77
+fi
+rm -rf "$work"
+mkdir -p "$work"
+"$trajroi" sim --quiet --scenario "$scenario" --out "$work/run" >/dev/null
+
+unshare --net /bin/bash -s "$trajroid" "$work" "${PYTHON:-python3}" <<'NETNS'
+set -euo pipefail
+trajroid=$1 work=$2 python=$3
+fail() { echo "FAIL: $*" >&2; exit 1; }
+# The kernel's fragments for one datagram of the outlet's largest size, sent to the group (ttl=0).
+kernel_fragments() {
+  "$python" - <<'PY'
+import socket
+def created():
+    rows = [line.split() for line in open("/proc/net/snmp") if line.startswith("Ip:")]
+    return int(rows[1][rows[0].index("FragCreates")])
+s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+s.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
+before = created()
+s.sendto(b"\0" * 65507, ("239.255.76.67", 7667))
+print(created() - before)
+PY
+}
+replay() {  # label [trajroid options…]: the log of an as-fast replay
+  local label=$1
+  shift
+  "$trajroid" --config "$work/run/trajroid.yaml" --replay "$work/run" --rate max "$@" >"$work/$label.log" 2>&1 ||
+    fail "$label: trajroid exited with $? ($(tail -n 3 "$work/$label.log"))"
+  grep -q "summary: .* published [1-9]" "$work/$label.log" || fail "$label: no cloud published"
+}
+advice() { grep "ttl=0 keeps the datagrams on this host" "$work/$1.log" || true; }
+
+ip link set lo up
+ip link add trajroi0 mtu 1500 type veth peer name trajroi1 mtu 1500
+ip addr add 10.200.0.1/24 dev trajroi0
+ip link set trajroi1 up
+ip link set trajroi0 up
+ip route add 224.0.0.0/4 dev trajroi0
+fragments=$(kernel_fragments)
+echo "route over trajroi0 (MTU 1500): the kernel cut a 65 507-byte datagram into $fragments fragments"
+[ "$fragments" -gt 1 ] || fail "the kernel did not fragment the datagram ($fragments)"
+
+replay veth
+line=$(advice veth)
+echo "trajroid: ${line#*info  }"
+grep -q "goes through trajroi0 (MTU 1500): each 64 KB datagram of a cloud is cut into $fragments IP fragments" <<<"$line" ||
+  fail "no line naming trajroi0, its MTU and $fragments fragments"
+grep -q "ip route add 239.255.76.67/32 dev lo" <<<"$line" || fail "the line does not say how to route the group over lo"
+
+replay ttl1 --lcm-url "udpm://239.255.76.67:7667?ttl=1"
+[ -z "$(advice ttl1)" ] || fail "advice for a group meant to leave the host (ttl=1)"
+
+# A route's own mtu is the one the kernel fragments by (lo's 65 536 would not).
+ip link set lo multicast on
+ip route replace 224.0.0.0/4 dev lo mtu 1400
+fragments=$(kernel_fragments)
+replay lo1400
+grep -q "goes through lo (MTU 1400): each 64 KB datagram of a cloud is cut into $fragments IP fragments" <<<"$(advice lo1400)" ||
+  fail "no line naming lo's route of mtu 1400 and the kernel's $fragments fragments"
+
+ip route replace 224.0.0.0/4 dev lo
+[ "$(kernel_fragments)" -eq 0 ] || fail "the kernel still fragments over lo"
+replay lo
+[ -z "$(advice lo)" ] || fail "advice for a group routed over lo"
+echo "PASS: named over trajroi0 and over a route of mtu 1400 with the kernel's fragments; nothing said for ttl=1 or over lo"
+NETNS
