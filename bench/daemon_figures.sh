@@ -8,8 +8,17 @@
 # Each kind is run TRAJROI_FIGURE_RUNS times (5)
 # and its medians are the figures. Beside each real-time run, `trajroi machine` says how
 # steadily the machine gave a thread its CPU meanwhile (its longest slow spell).
+# The LCM group's route is printed with the figures: the publishing thread's CPU depends on it
+# (docs/lcm.md, "The group's route on one machine"). TRAJROI_FIGURES_ROUTE=lo measures in a
+# network namespace of the script's own whose group goes over lo, as on a robot whose
+# subscribers all run on it (needs root, unshare and ip); otherwise the machine's own route.
 # Usage: bench/daemon_figures.sh [BUILD_DIR]   (default build/release)
 set -euo pipefail
+if [ "${TRAJROI_FIGURES_ROUTE:-}" = lo ] && [ -z "${TRAJROI_FIGURES_NETNS:-}" ]; then
+  export TRAJROI_FIGURES_NETNS=1
+  exec unshare --net bash -c \
+    'ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo && exec bash "$0" "$@"' "$0" "$@"
+fi
 export LC_NUMERIC=C  # bash's time and awk agree on the decimal point
 cd "$(dirname "$0")/.."
 # shellcheck source=scripts/lib/host.sh
@@ -55,6 +64,8 @@ figures() {  # rate [run] → "latency_p50 latency_p99 drops wall_s cpu_s pipeli
 }
 
 echo "scenario: tests/daemon/corridor.yaml, dual return, ${duration} s of data"
+route=$(ip route get 239.255.76.67 2>/dev/null | head -n 1 | sed 's/ *$//' || true)
+echo "LCM group udpm://239.255.76.67:7667?ttl=0, its route: ${route:-unknown}${TRAJROI_FIGURES_NETNS:+ (in a network namespace of the script, TRAJROI_FIGURES_ROUTE=lo)}"
 # Where these figures come from: the CPU, its cores, and the ROI scan trajroid calibrated.
 start=$("$build/daemon/trajroid" --config "$run/trajroid.yaml" --replay "$run" --rate max 2>&1)
 scan=$(grep "roi scan for" <<<"$start" || true)

@@ -99,7 +99,7 @@ std::optional<UdpmRoute> udpm_route(const LcmGroup& group) {
   if (!route) return std::nullopt;
   std::array<char, IF_NAMESIZE> name{};
   if (if_indextoname(route->first, name.data()) == nullptr) return std::nullopt;
-  UdpmRoute r{name.data(), static_cast<int>(route->second)};
+  UdpmRoute r{name.data(), static_cast<int>(route->second), route->second != 0};
   if (r.mtu == 0) {  // the interface's own
     const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
     if (fd < 0) return std::nullopt;
@@ -125,12 +125,19 @@ int udpm_fragments_per_datagram(int mtu) noexcept {
 std::string udpm_route_advice(const std::string& url, const LcmGroup& group, const UdpmRoute& route) {
   const int fragments = udpm_fragments_per_datagram(route.mtu);
   if (group.ttl != 0 || fragments <= 1) return {};
+  std::string remedy;
+  if (route.interface != "lo") {
+    remedy = "when every subscriber runs here, route the group over lo (ip link set lo multicast on; ip route add " +
+             group.address + "/32 dev lo";
+  } else if (route.route_mtu) {
+    remedy = "the route over lo sets that MTU itself: make it again without mtu (ip route get " + group.address +
+             " shows it; ip route replace <its prefix> dev lo";
+  } else {
+    remedy = "lo's own MTU is that small: give it back its 65536 (ip link set lo mtu 65536";
+  }
   return "LCM " + url + ": ttl=0 keeps the datagrams on this host, but the group's route goes through " +
          route.interface + " (MTU " + std::to_string(route.mtu) + "): each 64 KB datagram of a cloud is cut into " +
-         std::to_string(fragments) +
-         " IP fragments, each copied and checksummed; when every subscriber runs here, route the group over lo "
-         "(ip link set lo multicast on; ip route add " +
-         group.address + "/32 dev lo; docs/lcm.md)";
+         std::to_string(fragments) + " IP fragments, each copied and checksummed; " + remedy + "; docs/lcm.md)";
 }
 
 }  // namespace trajroi::daemon

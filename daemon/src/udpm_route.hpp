@@ -17,6 +17,7 @@ namespace trajroi::daemon {
 struct UdpmRoute {
   std::string interface;
   int mtu = 0;
+  bool route_mtu = false;  // the MTU is the route's own (its mtu metric), not the interface's
 };
 [[nodiscard]] std::optional<UdpmRoute> udpm_route(const LcmGroup& group);
 
@@ -26,7 +27,8 @@ struct UdpmRoute {
 [[nodiscard]] int udpm_fragments_per_datagram(int mtu) noexcept;
 
 // The start-up line for a ttl=0 group routed where its largest datagrams are fragmented: what
-// it costs and how to route the group over lo instead. Empty when there is nothing to say.
+// it costs and the remedy: route the group over lo, or, when it already goes over lo, take
+// the small MTU off that route or raise lo's own. Empty when there is nothing to say.
 [[nodiscard]] std::string udpm_route_advice(const std::string& url, const LcmGroup& group, const UdpmRoute& route);
 
 }  // namespace trajroi::daemon

@@ -3,12 +3,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <type_traits>
 
 namespace trajroi::test {
 
@@ -32,6 +34,29 @@ inline std::string read_file(const std::filesystem::path& path) {
   in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   return bytes;
 }
+
+// A parameterised test's name for a data file: the file's base name, its characters other
+// than letters and digits made '_' (gtest's rule for names), e.g. "ublox_zed_f9p_log".
+inline std::string file_test_name(std::string_view path) {
+  std::string name(path.substr(path.rfind('/') + 1));
+  for (char& c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  }
+  return name;
+}
+
+// INSTANTIATE_TEST_SUITE_P's name generator for parameters that are a data file's path or
+// name it in their `file`.
+struct FileTestName {
+  template <class T>
+  std::string operator()(const ::testing::TestParamInfo<T>& info) const {
+    if constexpr (std::is_convertible_v<T, std::string_view>) {
+      return file_test_name(info.param);
+    } else {
+      return file_test_name(info.param.file);
+    }
+  }
+};
 
 // A path in the test's temporary folder that no other test process uses: ctest runs tests in
 // parallel, each in its own process, so a fixed name would be shared between them.

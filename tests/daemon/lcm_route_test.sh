@@ -4,15 +4,14 @@
 # datagram (its FragCreates counter over one 65 507-byte datagram sent to the group), and says
 # nothing when the group goes over lo or is meant to leave the host (ttl=1). All in a network
 # namespace of its own: a veth pair of MTU 1 500 carries the group, then lo with a route of
-# mtu 1 400, then lo as it is.
+# mtu 1 400, then lo itself with an MTU of 1 500, then lo as it is; over lo, the line says to
+# mend the route's or lo's MTU rather than to route the group over lo.
 # Usage: lcm_route_test.sh TRAJROI TRAJROID SCENARIO WORK
 set -euo pipefail
 trajroi=$1 trajroid=$2 scenario=$3 work=$4
-if [ "$(id -u)" -ne 0 ] || ! command -v unshare >/dev/null || ! command -v ip >/dev/null; then
-  echo "lcm_route_test: needs root, unshare and ip" >&2
-  [ "${CI:-}" = true ] && exit 1
-  exit 77
-fi
+# shellcheck source=../lib/skip.sh
+source "$(dirname "$0")/../lib/skip.sh"
+require_netns lcm_route_test
 rm -rf "$work"
 mkdir -p "$work"
 "$trajroi" sim --quiet --scenario "$scenario" --out "$work/run" >/dev/null
@@ -69,12 +68,28 @@ ip link set lo multicast on
 ip route replace 224.0.0.0/4 dev lo mtu 1400
 fragments=$(kernel_fragments)
 replay lo1400
-grep -q "goes through lo (MTU 1400): each 64 KB datagram of a cloud is cut into $fragments IP fragments" <<<"$(advice lo1400)" ||
+line=$(advice lo1400)
+echo "trajroid: ${line#*info  }"
+grep -q "goes through lo (MTU 1400): each 64 KB datagram of a cloud is cut into $fragments IP fragments" <<<"$line" ||
   fail "no line naming lo's route of mtu 1400 and the kernel's $fragments fragments"
+grep -q "the route over lo sets that MTU itself: make it again without mtu" <<<"$line" ||
+  fail "the line over lo does not say to take the route's mtu off ($line)"
+
+# lo's own MTU made small (the route without one): the remedy is lo's MTU.
+ip route replace 224.0.0.0/4 dev lo
+ip link set lo mtu 1500
+fragments=$(kernel_fragments)
+replay lo1500
+line=$(advice lo1500)
+echo "trajroid: ${line#*info  }"
+grep -q "goes through lo (MTU 1500): each 64 KB datagram of a cloud is cut into $fragments IP fragments" <<<"$line" ||
+  fail "no line naming lo's MTU of 1500 and the kernel's $fragments fragments"
+grep -q "ip link set lo mtu 65536" <<<"$line" || fail "the line does not say to give lo its MTU back ($line)"
+ip link set lo mtu 65536
 
 ip route replace 224.0.0.0/4 dev lo
 [ "$(kernel_fragments)" -eq 0 ] || fail "the kernel still fragments over lo"
 replay lo
 [ -z "$(advice lo)" ] || fail "advice for a group routed over lo"
-echo "PASS: named over trajroi0 and over a route of mtu 1400 with the kernel's fragments; nothing said for ttl=1 or over lo"
+echo "PASS: named over trajroi0, over lo's route of mtu 1400 and over lo of MTU 1500 with the kernel's fragments and each its remedy; nothing said for ttl=1 or over lo"
 NETNS

@@ -210,7 +210,24 @@ TEST(UdpmRoute, AdviceOnlyForAGroupKeptOnThisHostWhoseDatagramsAreFragmented) {
   EXPECT_NE(line.find("route goes through eth0 (MTU 1500): each 64 KB datagram of a cloud is cut into 45 IP fragments"),
             std::string::npos)
       << line;
-  EXPECT_NE(line.find("ip link set lo multicast on; ip route add 239.255.76.67/32 dev lo"), std::string::npos) << line;
+  EXPECT_NE(line.find("ip link set lo multicast on; ip route add 239.255.76.67/32 dev lo; docs/lcm.md)"),
+            std::string::npos)
+      << line;
+  // Already over lo: the small MTU is the route's (its mtu metric) or lo's own, and the remedy
+  // says which to mend instead of routing the group over lo again.
+  const std::string route_mtu = udpm_route_advice(url, group, {"lo", 1400, true});
+  EXPECT_NE(route_mtu.find("goes through lo (MTU 1400): each 64 KB datagram of a cloud is cut into 48 IP fragments"),
+            std::string::npos)
+      << route_mtu;
+  EXPECT_NE(route_mtu.find("the route over lo sets that MTU itself: make it again without mtu (ip route get "
+                           "239.255.76.67 shows it"),
+            std::string::npos)
+      << route_mtu;
+  EXPECT_EQ(route_mtu.find("ip route add"), std::string::npos) << route_mtu;
+  const std::string link_mtu = udpm_route_advice(url, group, {"lo", 1500, false});
+  EXPECT_NE(link_mtu.find("lo's own MTU is that small: give it back its 65536 (ip link set lo mtu 65536; docs/lcm.md)"),
+            std::string::npos)
+      << link_mtu;
   EXPECT_EQ(udpm_route_advice(url, group, {"lo", 65536}), "");
   EXPECT_EQ(udpm_route_advice(url, group, {"lo", 65535}), "");
   group.ttl = 1;  // meant to leave the host: its route is the network's business

@@ -12,7 +12,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 # shellcheck source=../systemd/nsd.sh
 source "$here/../systemd/nsd.sh"
 nsd_require
-command -v dpkg >/dev/null || { echo "no dpkg: not a Debian machine" >&2; exit 77; }
+command -v dpkg >/dev/null || skip_or_fail "no dpkg: not a Debian machine"
 fail() {
   echo "FAIL: $*" >&2
   [ -n "$NSD_PID1" ] && nsd journalctl -u trajroid.service --no-pager -o cat | tail -30 >&2

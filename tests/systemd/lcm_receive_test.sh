@@ -8,11 +8,9 @@
 set -euo pipefail
 trajroi=$1 trajroid=$2 scenario=$3 drop_in=$4 python_path=$5 work=$6
 here=$(cd "$(dirname "$0")" && pwd)
-if [ "$(id -u)" -ne 0 ] || ! command -v unshare >/dev/null || ! command -v ip >/dev/null; then
-  echo "lcm_receive_test: needs root, unshare and ip" >&2
-  [ "${CI:-}" = true ] && exit 1
-  exit 77
-fi
+# shellcheck source=../lib/skip.sh
+source "$here/../lib/skip.sh"
+require_netns lcm_receive_test
 rm -rf "$work"
 mkdir -p "$work"
 "$trajroi" sim --quiet --scenario "$scenario" --out "$work/run" >/dev/null

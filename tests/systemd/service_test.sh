@@ -155,11 +155,7 @@ live)
   ubx=$data_dir/ublox/gpsd/ublox-neo-m8p.log
   vn100=$data_dir/vectornav/LoggerWavesInIce_F00379.raw
   for f in "$pcap" "$ubx" "$vn100"; do
-    if [ ! -f "$f" ]; then
-      echo "SKIP: $f is missing (TRAJROI_DATA_DIR)" >&2
-      [ "${CI:-}" = true ] && exit 1
-      exit 77
-    fi
+    [ -f "$f" ] || skip_or_fail "$f is missing (TRAJROI_DATA_DIR)"
   done
   printf 'lat,lon\n50.13480,14.42995\n50.13540,14.42995\n' >"$work/trajectory.csv"
   cat >"$work/trajroid.yaml" <<YAML
@@ -272,18 +268,10 @@ rtk)
   rover_log=$data_dir/ublox/gpsd/ublox-zed-f9r.log
   base_log=$data_dir/ublox/gpsd/ublox-zed-f9t-rtcm3.log
   for f in "$rover_log" "$base_log"; do
-    if [ ! -f "$f" ]; then
-      echo "SKIP: $f is missing (TRAJROI_DATA_DIR)" >&2
-      [ "${CI:-}" = true ] && exit 1
-      exit 77
-    fi
+    [ -f "$f" ] || skip_or_fail "$f is missing (TRAJROI_DATA_DIR)"
   done
   for tool in str2str /usr/sbin/chronyd lcm-logger; do
-    if ! command -v "$tool" >/dev/null; then
-      echo "SKIP: $tool is missing (scripts/install-deps.sh installs rtklib, chrony, liblcm-bin)" >&2
-      [ "${CI:-}" = true ] && exit 1
-      exit 77
-    fi
+    command -v "$tool" >/dev/null || skip_or_fail "$tool is missing (scripts/install-deps.sh installs rtklib, chrony, liblcm-bin)"
   done
   peer() { nsd "${PYTHON:-python3}" "$here/rtk_peer.py" "$@"; }
   segment_made() { nsd ipcs -m | grep -q 0x4e545032; }

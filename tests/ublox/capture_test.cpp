@@ -135,17 +135,6 @@ const std::vector<LogExpectation>& logs() {
   return kLogs;
 }
 
-// The test name of a parameter naming a log file: its base name, alphanumerics only.
-template <class T>
-std::string file_test_name(const ::testing::TestParamInfo<T>& param) {
-  std::string name = param.param.file;
-  name = name.substr(name.rfind('/') + 1);
-  for (char& c : name) {
-    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-  }
-  return name;
-}
-
 void PrintTo(const LogExpectation& e, std::ostream* os) {
   *os << e.file;
 }
@@ -211,7 +200,7 @@ TEST_P(UbxLog, EveryNavPvtDecodes) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Logs, UbxLog, ::testing::ValuesIn(logs()), file_test_name<LogExpectation>);
+INSTANTIATE_TEST_SUITE_P(Logs, UbxLog, ::testing::ValuesIn(logs()), test::FileTestName{});
 
 // ---- Against gpsd's .chk --------------------------------------------------------------------
 
@@ -350,7 +339,7 @@ TEST_P(GpsdChk, NavPvtEpochsEqualGpsdTpv) {
   EXPECT_EQ(disagree, e.disagree);
 }
 
-INSTANTIATE_TEST_SUITE_P(Logs, GpsdChk, ::testing::ValuesIn(chk_logs()), file_test_name<ChkExpectation>);
+INSTANTIATE_TEST_SUITE_P(Logs, GpsdChk, ::testing::ValuesIn(chk_logs()), test::FileTestName{});
 
 // ---- pyubx2's expected values (tests/test_stream.py, testNAVLOG2) ----------------------------
 

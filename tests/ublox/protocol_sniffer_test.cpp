@@ -54,7 +54,7 @@ INSTANTIATE_TEST_SUITE_P(Readme, SnifferOnGpsdLogs,
                                          Expected{"ublox-neo-m8l.log", 14, 0},
                                          Expected{"ublox8-uniqid-monhw.log", 52, 0},
                                          Expected{"ublox-zed-f9p-hp.log", 0, 0}),
-                         [](const testing::TestParamInfo<Expected>& p) { return std::to_string(p.index); });
+                         [](const testing::TestParamInfo<Expected>& p) { return test::file_test_name(p.param.log); });
 
 TEST(ProtocolSniffer, RandomBytesAreNoneOfThem) {
   std::mt19937 random(7);

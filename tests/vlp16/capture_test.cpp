@@ -146,7 +146,8 @@ INSTANTIATE_TEST_SUITE_P(
                     RejectedCapture{"velodyne/other_models/rust-lidar-utils_velodyne_vlp32_ACTUALLY_HDL-32E.pcap", 91,
                                     "product id 0x21 (HDL-32E) sends HDL-32E packets"},
                     RejectedCapture{"velodyne/other_models/nebula_vlp32c_strongest_1713492677.DERIVED.pcap", 379,
-                                    "product id 0x28 (VLP-32C) sends VLP-32C packets, but lidar.model is vlp16"}));
+                                    "product id 0x28 (VLP-32C) sends VLP-32C packets, but lidar.model is vlp16"}),
+    trajroi::test::FileTestName{});
 
 // The reader thread's early wake-up: every whole frame the decoder completes on a real capture
 // is completed by a packet may_complete_frame foresaw, at cuts all round; and it foresees few
@@ -187,7 +188,8 @@ TEST_P(Vlp16ForeseesFrameEnds, EveryWholeFrameEndsOnAForeseenPacket) {
 
 INSTANTIATE_TEST_SUITE_P(Captures, Vlp16ForeseesFrameEnds,
                          testing::Values("velodyne/vlp16/mrpt_sample_velodyne_vlp16_gps.pcap",
-                                         "velodyne/vlp16/nebula_vlp16_dual_1673400471.DERIVED.pcap"));
+                                         "velodyne/vlp16/nebula_vlp16_dual_1673400471.DERIVED.pcap"),
+                         trajroi::test::FileTestName{});
 
 TEST(Vlp16Stream, CutCentidegreesWrapsAndRounds) {
   EXPECT_EQ(cut_centidegrees(0.0), 0);

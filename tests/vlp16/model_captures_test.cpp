@@ -221,10 +221,10 @@ TEST_P(Hdl32eCapture, EveryPacketIsTheManualsDecode) {
   EXPECT_LE(worst, 1e-4) << "worst " << worst << " m over " << points << " points";
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Captures, Hdl32eCapture,
-    testing::Values("velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap",
-                    "velodyne/other_models/rust-lidar-utils_velodyne_vlp32_ACTUALLY_HDL-32E.pcap"));
+INSTANTIATE_TEST_SUITE_P(Captures, Hdl32eCapture,
+                         testing::Values("velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap",
+                                         "velodyne/other_models/rust-lidar-utils_velodyne_vlp32_ACTUALLY_HDL-32E.pcap"),
+                         trajroi::test::FileTestName{});
 
 // The model told from the packets (lidar.model auto), never configured: the HDL-32E captures
 // (0x21 at 553 µs), the early VLP-16 that sent 0x21 (1327 µs), the VLP-32C (0x28).
@@ -260,7 +260,8 @@ INSTANTIATE_TEST_SUITE_P(
         ToldCapture{"velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap", Model::kHdl32e, 500},
         ToldCapture{"velodyne/other_models/rust-lidar-utils_velodyne_vlp32_ACTUALLY_HDL-32E.pcap", Model::kHdl32e, 91},
         ToldCapture{"velodyne/vlp16/rust-lidar-utils_velodyne_vlp16_2014_productid0x21.pcap", Model::kVlp16, 84},
-        ToldCapture{"velodyne/other_models/nebula_vlp32c_strongest_1713492677.DERIVED.pcap", Model::kVlp32c, 379}));
+        ToldCapture{"velodyne/other_models/nebula_vlp32c_strongest_1713492677.DERIVED.pcap", Model::kVlp32c, 379}),
+    trajroi::test::FileTestName{});
 
 }  // namespace
 }  // namespace trajroi::vlp16
