@@ -42,6 +42,20 @@ replay() {  # label [trajroid options…]: the log of an as-fast replay
   grep -q "summary: .* published [1-9]" "$work/$label.log" || fail "$label: no cloud published"
 }
 advice() { grep "ttl=0 keeps the datagrams on this host" "$work/$1.log" || true; }
+# label interface mtu remedy: a replay's line names the interface, its MTU, the kernel's own
+# fragment count for one datagram over the route as it now is, and the remedy.
+named() {
+  local label=$1 interface=$2 mtu=$3 remedy=$4 fragments line
+  fragments=$(kernel_fragments)
+  echo "route over $interface (MTU $mtu): the kernel cut a 65 507-byte datagram into $fragments fragments"
+  [ "$fragments" -gt 1 ] || fail "$label: the kernel did not fragment the datagram ($fragments)"
+  replay "$label"
+  line=$(advice "$label")
+  echo "trajroid: ${line#*info  }"
+  grep -qF "goes through $interface (MTU $mtu): each 64 KB datagram of a cloud is cut into $fragments IP fragments" <<<"$line" ||
+    fail "$label: no line naming $interface, its MTU of $mtu and the kernel's $fragments fragments"
+  grep -qF "$remedy" <<<"$line" || fail "$label: the line does not give the remedy '$remedy'"
+}
 
 ip link set lo up
 ip link add trajroi0 mtu 1500 type veth peer name trajroi1 mtu 1500
@@ -49,42 +63,22 @@ ip addr add 10.200.0.1/24 dev trajroi0
 ip link set trajroi1 up
 ip link set trajroi0 up
 ip route add 224.0.0.0/4 dev trajroi0
-fragments=$(kernel_fragments)
-echo "route over trajroi0 (MTU 1500): the kernel cut a 65 507-byte datagram into $fragments fragments"
-[ "$fragments" -gt 1 ] || fail "the kernel did not fragment the datagram ($fragments)"
-
-replay veth
-line=$(advice veth)
-echo "trajroid: ${line#*info  }"
-grep -q "goes through trajroi0 (MTU 1500): each 64 KB datagram of a cloud is cut into $fragments IP fragments" <<<"$line" ||
-  fail "no line naming trajroi0, its MTU and $fragments fragments"
-grep -q "ip route add 239.255.76.67/32 dev lo" <<<"$line" || fail "the line does not say how to route the group over lo"
+named veth trajroi0 1500 "route the group over lo (ip link set lo multicast on; ip route add 239.255.76.67/32 dev lo"
 
 replay ttl1 --lcm-url "udpm://239.255.76.67:7667?ttl=1"
 [ -z "$(advice ttl1)" ] || fail "advice for a group meant to leave the host (ttl=1)"
 
-# A route's own mtu is the one the kernel fragments by (lo's 65 536 would not).
+# A route's own mtu is the one the kernel fragments by (lo's 65 536 would not); over lo the
+# remedy is that mtu, not routing the group over lo again.
 ip link set lo multicast on
 ip route replace 224.0.0.0/4 dev lo mtu 1400
-fragments=$(kernel_fragments)
-replay lo1400
-line=$(advice lo1400)
-echo "trajroid: ${line#*info  }"
-grep -q "goes through lo (MTU 1400): each 64 KB datagram of a cloud is cut into $fragments IP fragments" <<<"$line" ||
-  fail "no line naming lo's route of mtu 1400 and the kernel's $fragments fragments"
-grep -q "the route over lo sets that MTU itself: make it again without mtu" <<<"$line" ||
-  fail "the line over lo does not say to take the route's mtu off ($line)"
+named lo1400 lo 1400 "the route over lo sets that MTU itself: make it again without mtu"
+! grep -q "ip route add" <<<"$(advice lo1400)" || fail "lo1400: the line says to route the group over lo again"
 
 # lo's own MTU made small (the route without one): the remedy is lo's MTU.
 ip route replace 224.0.0.0/4 dev lo
 ip link set lo mtu 1500
-fragments=$(kernel_fragments)
-replay lo1500
-line=$(advice lo1500)
-echo "trajroid: ${line#*info  }"
-grep -q "goes through lo (MTU 1500): each 64 KB datagram of a cloud is cut into $fragments IP fragments" <<<"$line" ||
-  fail "no line naming lo's MTU of 1500 and the kernel's $fragments fragments"
-grep -q "ip link set lo mtu 65536" <<<"$line" || fail "the line does not say to give lo its MTU back ($line)"
+named lo1500 lo 1500 "ip link set lo mtu 65536"
 ip link set lo mtu 65536
 
 ip route replace 224.0.0.0/4 dev lo
