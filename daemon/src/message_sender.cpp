@@ -37,7 +37,7 @@ void MessageSender::send_points() {
 }
 
 void MessageSender::send_raw_points(const pipeline::Sweep& s) {
-  daemon::encode_points(s, s.raw, {}, config_, points_, raw_encoded_);
+  daemon::encode_points(s, s.raw, s.raw_sensor_index, config_, points_, raw_encoded_);
   outlet_.publish(config_.lcm.raw_points, raw_encoded_);
 }
 

@@ -98,6 +98,7 @@ void Sweep::take(Sweep& other) {
   static_cast<SweepHeader&>(*this) = other;
   PointColumns::swap(other);
   raw.swap(other.raw);
+  raw_sensor_index.swap(other.raw_sensor_index);
   sensor_index.swap(other.sensor_index);
   point_index = other.point_index;  // kept for evaluations only: unreserved in the ring's slots
 }
@@ -106,6 +107,7 @@ void Sweep::reserve(std::size_t points, std::size_t centre_count, std::size_t ra
   PointColumns::reserve(points);
   sensor_index.reserve(points);
   raw.reserve(raw_points);
+  raw_sensor_index.reserve(raw_points);
   centres.reserve(centre_count);
 }
 
@@ -114,6 +116,7 @@ void Sweep::make_resident() {
   PointColumns::make_resident();
   make_capacity_resident(sensor_index);
   raw.make_resident();
+  make_capacity_resident(raw_sensor_index);
 }
 
 void Sweep::make_resident_to(std::size_t points) {
@@ -125,6 +128,7 @@ void Sweep::make_resident_to(std::size_t points) {
 void Sweep::clear_points() noexcept {
   PointColumns::clear();
   raw.clear();
+  raw_sensor_index.clear();
   sensor_index.clear();
   point_index.clear();
 }

@@ -1,27 +1,41 @@
 #include "trajroi/pipeline/sweep_merger.hpp"
 
 #include <algorithm>
+#include <cstring>
 
 namespace trajroi::pipeline {
 namespace {
 
+// `n` elements more at the end of `v`, unwritten (PointColumns' arrays do not zero what they
+// grow by); where they start.
 template <typename Array>
-void append_array(Array& to, const Array& from, std::size_t room) {
-  const std::size_t n = std::min(from.size(), room);
-  to.insert(to.end(), from.begin(), from.begin() + static_cast<std::ptrdiff_t>(n));
+auto* grown(Array& v, std::size_t n) {
+  const std::size_t at = v.size();
+  v.resize(at + n);
+  return v.data() + at;
 }
 
-// The columns of `from` after those of `to`, as far as `capacity` allows; the count appended.
-std::size_t append_columns(PointColumns& to, const PointColumns& from, std::size_t capacity) {
-  const std::size_t room = capacity - std::min(capacity, to.size());
-  append_array(to.x, from.x, room);
-  append_array(to.y, from.y, room);
-  append_array(to.z, from.z, room);
-  append_array(to.intensity, from.intensity, room);
-  append_array(to.ring, from.ring, room);
-  append_array(to.return_type, from.return_type, room);
-  append_array(to.time_offset_ns, from.time_offset_ns, room);
-  return std::min(from.size(), room);
+// The first `n` elements of `from` after those of `to`, in one copy.
+template <typename Array>
+void append_array(Array& to, const Array& from, std::size_t n) {
+  if (n != 0) std::memcpy(grown(to, n), from.data(), n * sizeof(from[0]));
+}
+
+// The columns of `from` after those of `to`, as far as `capacity` allows, their time offsets
+// moved by `shift_ns` (they count from the merged sweep's start); the count appended.
+std::size_t append_columns(PointColumns& to, const PointColumns& from, std::size_t capacity, std::int32_t shift_ns) {
+  const std::size_t n = std::min(from.size(), capacity - std::min(capacity, to.size()));
+  append_array(to.x, from.x, n);
+  append_array(to.y, from.y, n);
+  append_array(to.z, from.z, n);
+  append_array(to.intensity, from.intensity, n);
+  append_array(to.ring, from.ring, n);
+  append_array(to.return_type, from.return_type, n);
+  std::int32_t* const t = grown(to.time_offset_ns, n);
+  const std::int32_t* const f = from.time_offset_ns.data();
+  for (std::size_t k = 0; k < n; ++k)
+    t[k] = f[k] + shift_ns;
+  return n;
 }
 
 }  // namespace
@@ -95,8 +109,11 @@ void SweepMerger::append(std::size_t sensor, const Sweep& sweep) {
     const std::uint32_t points_in = m.points_in + sweep.points_in, lost = m.lost_packets + sweep.lost_packets;
     const std::uint32_t truncated = m.truncated + sweep.truncated, sensors = m.sensors;
     // The points' times are after the window's start: earlier now, those in it move along.
+    const auto earlier = static_cast<std::int32_t>(m.start_ns - start);
     for (std::int32_t& t : m.time_offset_ns)
-      t += static_cast<std::int32_t>(m.start_ns - start);
+      t += earlier;
+    for (std::int32_t& t : m.raw.time_offset_ns)
+      t += earlier;
     if (!m.filtered && sweep.filtered) static_cast<SweepHeader&>(m) = sweep;  // into reserved room
     m.start_ns = start;
     m.end_ns = end;
@@ -110,14 +127,12 @@ void SweepMerger::append(std::size_t sensor, const Sweep& sweep) {
   }
   m.sensors |= 1U << sensor;
   if (!sweep.filtered) return;  // a sweep without a valid pose has no points
-  const std::size_t from = m.size();
-  const std::size_t n = append_columns(m, sweep, capacity_);
   const auto shift = static_cast<std::int32_t>(sweep.start_ns - m.start_ns);
-  for (std::size_t i = from; i < m.size(); ++i)
-    m.time_offset_ns[i] += shift;
+  const std::size_t n = append_columns(m, sweep, capacity_, shift);
   m.truncated += static_cast<std::uint32_t>(sweep.size() - n);
-  m.sensor_index.insert(m.sensor_index.end(), n, static_cast<std::uint8_t>(sensor));
-  (void)append_columns(m.raw, sweep.raw, m.raw.x.capacity());
+  if (n != 0) std::memset(grown(m.sensor_index, n), static_cast<int>(sensor), n);
+  const std::size_t raw = append_columns(m.raw, sweep.raw, m.raw.x.capacity(), shift);
+  if (raw != 0) std::memset(grown(m.raw_sensor_index, raw), static_cast<int>(sensor), raw);
 }
 
 void SweepMerger::emit(SweepSink& sink) {

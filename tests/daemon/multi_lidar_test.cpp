@@ -3,8 +3,10 @@
 // return), to one port (told apart by sender) or to two ports, the two sensors mounted
 // differently. Each merged points_t must hold, for each sensor, exactly what `trajroi filter`
 // keeps of one of that capture's sweeps placed with the sensor's pose (the published robot pose
-// times its mounting) against the published ROI. The rear sensor then stops while the front
-// one goes on: the rear is named silent, and the front's sweeps are still published, alone.
+// times its mounting) against the published ROI, and each merged raw_points every third point
+// of those sweeps, by index, placed alike, marked with its sensor, its times moved as the kept
+// points' were. The rear sensor then stops while the front one goes on: the rear is named
+// silent, and the front's sweeps are still published, alone.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
@@ -53,18 +55,41 @@ trajroi::pipeline::PublishedPose sensor_pose(const trajroi::points_t& m, const E
   return trajroi::pipeline::PublishedPose::from(robot.isometry() * robot_from_lidar);
 }
 
-// Whether the points of sensor `index` in `m` are exactly what trajroi filter keeps of one of
-// its capture's sweeps (their times counted from the merged sweep's start: matched up to one
-// shift per sweep).
-bool matches_a_sweep(const trajroi::points_t& m, const trajroi::roi_t& roi, std::uint8_t index, const Sensor& sensor,
-                     const Rig& rig) {
+// The capture's sweep whose points sensor `index` has in `m`, and by how much their times
+// moved (they count from the merged sweep's start).
+struct Match {
+  const trajroi::vlp16::Frame* frame = nullptr;
+  std::int64_t shift_ns = 0;
+};
+
+// The points of sensor `index` in `m` (a points_t on the points or the raw_points channel).
+std::vector<std::size_t> points_of(const trajroi::points_t& m, std::uint8_t index) {
   std::vector<std::size_t> mine;
   for (std::size_t k = 0; k < static_cast<std::size_t>(m.num_points); ++k)
     if (m.sensor[k] == index) mine.push_back(k);
-  if (mine.empty()) return false;
+  return mine;
+}
+
+// Whether point k of `m` is the frame's point `p` placed with `pose`, its time moved by `shift_ns`.
+bool is_placed(const trajroi::points_t& m, std::size_t k, const trajroi::vlp16::Point& p,
+               const trajroi::pipeline::PublishedPose& pose, std::int64_t shift_ns) {
+  if (m.time_offset_ns[k] - shift_ns != static_cast<std::int64_t>(p.time_offset_ns) || m.ring[k] != p.ring ||
+      m.return_type[k] != static_cast<std::uint8_t>(p.return_type))
+    return false;
+  // Placed by this sensor's mounting: within float rounding of the pose times the point.
+  const Eigen::Vector3d g = pose.isometry() * Eigen::Vector3f(p.x, p.y, p.z).cast<double>();
+  return (g - Eigen::Vector3f(m.x[k], m.y[k], m.z[k]).cast<double>()).norm() < 1e-3;
+}
+
+// The sweep of which the points of sensor `index` in `m` are exactly what trajroi filter keeps
+// (placed with the sensor's pose, against the published ROI); none when no sweep matches.
+Match matching_sweep(const trajroi::points_t& m, const trajroi::roi_t& roi, std::uint8_t index, const Sensor& sensor,
+                     const Rig& rig) {
+  const std::vector<std::size_t> mine = points_of(m, index);
+  if (mine.empty()) return {};
+  const auto pose = sensor_pose(m, sensor.mounting);
   for (const auto& frame : sensor.frames) {
     if (frame.partial) continue;
-    const auto pose = sensor_pose(m, sensor.mounting);
     const auto expected = filter_keeps(frame, m, roi, rig.dir, rig.trajectory_xy,
                                        pose_argument(pose.position_m, pose.orientation.w(), pose.orientation.x(),
                                                      pose.orientation.y(), pose.orientation.z()));
@@ -72,18 +97,25 @@ bool matches_a_sweep(const trajroi::points_t& m, const trajroi::roi_t& roi, std:
     const std::int64_t shift =
         m.time_offset_ns[mine[0]] - static_cast<std::int64_t>(frame.points[expected[0]].time_offset_ns);
     bool same = true;
-    for (std::size_t j = 0; j < mine.size() && same; ++j) {
-      const auto& p = frame.points[expected[j]];
-      const std::size_t k = mine[j];
-      same = m.time_offset_ns[k] - shift == static_cast<std::int64_t>(p.time_offset_ns) && m.ring[k] == p.ring &&
-             m.return_type[k] == static_cast<std::uint8_t>(p.return_type);
-      // Placed by this sensor's mounting: within float rounding of the pose times the point.
-      const Eigen::Vector3d g = pose.isometry() * Eigen::Vector3f(p.x, p.y, p.z).cast<double>();
-      same = same && (g - Eigen::Vector3f(m.x[k], m.y[k], m.z[k]).cast<double>()).norm() < 1e-3;
-    }
-    if (same) return true;
+    for (std::size_t j = 0; j < mine.size() && same; ++j)
+      same = is_placed(m, mine[j], frame.points[expected[j]], pose, shift);
+    if (same) return {&frame, shift};
   }
-  return false;
+  return {};
+}
+
+// Whether the raw points (outputs.raw_points) of sensor `index` in `raw` are every
+// `decimation`th point of the matched sweep, by index, placed with the sensor's pose, their
+// times moved as the kept points' were.
+bool raw_matches(const trajroi::points_t& raw, std::uint8_t index, const Sensor& sensor, const Match& match,
+                 std::size_t decimation) {
+  const std::vector<std::size_t> mine = points_of(raw, index);
+  const std::vector<trajroi::vlp16::Point>& points = match.frame->points;
+  if (mine.size() != (points.size() + decimation - 1) / decimation) return false;
+  const auto pose = sensor_pose(raw, sensor.mounting);
+  for (std::size_t j = 0; j < mine.size(); ++j)
+    if (!is_placed(raw, mine[j], points[j * decimation], pose, match.shift_ns)) return false;
+  return true;
 }
 
 // Seconds into the day of the first log line holding `text` (its "YYYY-MM-DD HH:MM:SS.mmm").
@@ -180,9 +212,19 @@ TEST_P(MultiLidar, TwoLiveSendersMergeAsTrajroiFilterKeepsEachAndASilentOneIsNam
   text.replace(from, to - from, lidars + "lidar_merge: {max_wait_s: 0.15, silent_s: 0.5}\n");
   std::ofstream(rig.config) << text;
   rig.add_under("roi", "  circle_diameter_m: 3\n  look_ahead_m: 10\n");
+  // The decoded points before the ROI too, one in three: each tells its sensor.
+  constexpr std::size_t kDecimation = 3;
+  rig.add_under("outputs", "  raw_points: true\n  raw_points_decimation: " + std::to_string(kDecimation) + "\n");
+  text = slurp(rig.config);
+  const std::string last_channel = rig.prefix + "_POSE_INPUT}";
+  text.replace(text.find(last_channel), last_channel.size(),
+               rig.prefix + "_POSE_INPUT, raw_points: " + rig.prefix + "_RAW_POINTS}");
+  std::ofstream(rig.config) << text;
 
   Listener listener(rig.prefix);
   ASSERT_TRUE(listener.good());
+  Listener raw_listener(rig.prefix + "_RAW");  // its "points": <prefix>_RAW_POINTS
+  ASSERT_TRUE(raw_listener.good());
   // Recorded as it runs: the replay below must tell the sensors apart the same way.
   const fs::path recording = rig.dir / "recording";
   std::vector<std::string> args = rig.daemon_args();
@@ -219,7 +261,8 @@ TEST_P(MultiLidar, TwoLiveSendersMergeAsTrajroiFilterKeepsEachAndASilentOneIsNam
   const std::string silent = "lidar: rear (127.0.0.3 → UDP " + std::to_string(rear.data_port) + ") silent";
   EXPECT_NE(log.find(silent), std::string::npos) << log;
   const std::lock_guard<std::mutex> lock(listener.mutex);
-  std::size_t both = 0, matched_front = 0, matched_rear = 0, front_alone = 0;
+  const std::lock_guard<std::mutex> raw_lock(raw_listener.mutex);
+  std::size_t both = 0, matched_front = 0, matched_rear = 0, front_alone = 0, raw_front = 0, raw_rear = 0;
   for (const auto& [index, m] : listener.points) {
     ASSERT_EQ(m.num_sensors, 2) << "sweep " << index;
     EXPECT_EQ(m.sensor_names, (std::vector<std::string>{"front", "rear"}));
@@ -233,20 +276,32 @@ TEST_P(MultiLidar, TwoLiveSendersMergeAsTrajroiFilterKeepsEachAndASilentOneIsNam
     ASSERT_NE(roi, listener.rois.end());
     if (has[0] && has[1]) {
       ++both;
-      matched_front += matches_a_sweep(m, roi->second, 0, front, rig) ? 1U : 0U;
-      matched_rear += matches_a_sweep(m, roi->second, 1, rear, rig) ? 1U : 0U;
+      const Match f = matching_sweep(m, roi->second, 0, front, rig);
+      const Match r = matching_sweep(m, roi->second, 1, rear, rig);
+      matched_front += f.frame != nullptr ? 1U : 0U;
+      matched_rear += r.frame != nullptr ? 1U : 0U;
+      const auto raw = raw_listener.points.find(index);
+      if (raw == raw_listener.points.end()) continue;
+      EXPECT_EQ(raw->second.num_sensors, 2) << "sweep " << index;
+      EXPECT_EQ(raw->second.sensor_names, (std::vector<std::string>{"front", "rear"}));
+      raw_front += f.frame != nullptr && raw_matches(raw->second, 0, front, f, kDecimation) ? 1U : 0U;
+      raw_rear += r.frame != nullptr && raw_matches(raw->second, 1, rear, r, kDecimation) ? 1U : 0U;
     } else if (has[0] && !has[1] && m.missing.empty()) {
       // After the rear fell silent: not waited for, not missing.
-      front_alone += matches_a_sweep(m, roi->second, 0, front, rig) ? 1U : 0U;
+      front_alone += matching_sweep(m, roi->second, 0, front, rig).frame != nullptr ? 1U : 0U;
     }
   }
   std::printf(
       "[ multi lidar ] %s: %zu sweeps published, %zu with both sensors (front as trajroi filter keeps in %zu, "
-      "rear in %zu), %zu of the front alone after the rear fell silent\n",
-      one_port ? "one port" : "two ports", listener.points.size(), both, matched_front, matched_rear, front_alone);
+      "rear in %zu; their raw points as decoded, one in %zu, in %zu and %zu), %zu of the front alone after the "
+      "rear fell silent\n",
+      one_port ? "one port" : "two ports", listener.points.size(), both, matched_front, matched_rear, kDecimation,
+      raw_front, raw_rear, front_alone);
   EXPECT_GE(both, 2U) << log;
   EXPECT_GE(matched_front, 2U) << log;
   EXPECT_GE(matched_rear, 2U) << log;
+  EXPECT_GE(raw_front, 2U) << log;
+  EXPECT_GE(raw_rear, 2U) << log;
   EXPECT_GE(front_alone, 3U) << log;
   // Named within 1 s of its last datagram (the feed's end, by its log's time).
   const double said_s = logged_at(log, silent), ended_s = modified_at(rig.dir / "feed_rear.log");
@@ -267,7 +322,7 @@ TEST_P(MultiLidar, TwoLiveSendersMergeAsTrajroiFilterKeepsEachAndASilentOneIsNam
   Listener replayed(rig.prefix + "_R");
   ASSERT_TRUE(replayed.good());
   std::string replay_config = slurp(rig.config);
-  for (const char* channel : {"_POINTS", "_POSE", "_ROI", "_STATUS", "_TRAJECTORY", "_POSE_INPUT"}) {
+  for (const char* channel : {"_POINTS", "_POSE", "_ROI", "_STATUS", "_TRAJECTORY", "_POSE_INPUT", "_RAW_POINTS"}) {
     const std::string name = rig.prefix + channel;
     replay_config.replace(replay_config.find(name), name.size(), rig.prefix + "_R" + channel);
   }

@@ -20,6 +20,8 @@ struct Collect final : SweepSink {
     std::vector<std::uint8_t> sensor;
     std::vector<float> x;
     std::vector<std::int32_t> t;
+    std::vector<std::int32_t> raw_t;
+    std::vector<std::uint8_t> raw_sensor;
     bool filtered;
     std::uint32_t points_in;
   };
@@ -32,15 +34,18 @@ struct Collect final : SweepSink {
                    {s.sensor_index.begin(), s.sensor_index.end()},
                    {s.x.begin(), s.x.end()},
                    {s.time_offset_ns.begin(), s.time_offset_ns.end()},
+                   {s.raw.time_offset_ns.begin(), s.raw.time_offset_ns.end()},
+                   {s.raw_sensor_index.begin(), s.raw_sensor_index.end()},
                    s.filtered,
                    s.points_in});
   }
 };
 
-// A lane's sweep: `n` points at x = tag, times 0, 1, 2 … µs after `start_ns`.
+// A lane's sweep: `n` points at x = tag, times 0, 1, 2 … µs after `start_ns`; and as many raw
+// points (outputs.raw_points), times 0, 2, 4 … µs.
 Sweep sweep_of(std::int64_t start_ns, std::size_t n, float tag, bool filtered = true) {
   Sweep s;
-  s.reserve(100, 8);
+  s.reserve(100, 8, 100);
   s.start_ns = start_ns;
   s.end_ns = start_ns + 100 * kMs;
   s.filtered = filtered;
@@ -53,13 +58,20 @@ Sweep sweep_of(std::int64_t start_ns, std::size_t n, float tag, bool filtered = 
     s.ring.push_back(2);
     s.return_type.push_back(1);
     s.time_offset_ns.push_back(static_cast<std::int32_t>(i * 1000));
+    s.raw.x.push_back(tag);
+    s.raw.y.push_back(0.0F);
+    s.raw.z.push_back(0.0F);
+    s.raw.intensity.push_back(1);
+    s.raw.ring.push_back(2);
+    s.raw.return_type.push_back(1);
+    s.raw.time_offset_ns.push_back(static_cast<std::int32_t>(i * 2000));
   }
   if (!filtered) s.clear_points();
   return s;
 }
 
 TEST(SweepMerger, OneSweepOfEachSensorGoesOutTogetherWithEachPointsSensor) {
-  SweepMerger m(2, 100, 8, 0, MergeOptions{});
+  SweepMerger m(2, 100, 8, 100, MergeOptions{});
   Collect c;
   m.add(1, sweep_of(1000 * kMs + 30 * kMs, 2, 1.0F), 1100 * kMs, c);
   EXPECT_TRUE(c.out.empty());  // waits for sensor 0
@@ -73,6 +85,10 @@ TEST(SweepMerger, OneSweepOfEachSensorGoesOutTogetherWithEachPointsSensor) {
   EXPECT_EQ(o.x, (std::vector<float>{1, 1, 0, 0, 0}));
   // Times after the window's start: sensor 1's sweep began 30 ms after sensor 0's.
   EXPECT_EQ(o.t, (std::vector<std::int32_t>{30'000'000, 30'001'000, 0, 1000, 2000}));
+  // The decoded points before the ROI (outputs.raw_points) count from there too, and say
+  // their sensor.
+  EXPECT_EQ(o.raw_t, (std::vector<std::int32_t>{30'000'000, 30'002'000, 0, 2000, 4000}));
+  EXPECT_EQ(o.raw_sensor, (std::vector<std::uint8_t>{1, 1, 0, 0, 0}));
   EXPECT_EQ(o.points_in, 10U);
   EXPECT_TRUE(o.filtered);
 }

@@ -130,6 +130,8 @@ struct Sweep : SweepHeader, PointColumns {
   // before the ROI, one in outputs.raw_points_decimation (by its index in the sweep); empty
   // otherwise, and for a sweep without a valid pose.
   PointColumns raw;
+  // Several LiDARs: the sensor of each raw point, as sensor_index; empty for one LiDAR.
+  Array<std::uint8_t> raw_sensor_index;
 
   // Becomes `other`: its header copied, its points taken by exchanging arrays, so that
   // `other` is left with this sweep's arrays (their capacity: nothing is allocated, nothing
