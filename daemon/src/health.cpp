@@ -322,13 +322,19 @@ void HealthMonitor::update_state(const StatusSnapshot& s, const StatusSnapshot& 
     add("no valid pose: " + pipeline::pose_reason(s.pose_status, s.pose_measured, s.pose_limit, config_));
   const double since_s = static_cast<double>(s.steady_ns - previous.steady_ns) * 1e-9;
   const auto published = s.processor.sweeps_filtered - previous.processor.sweeps_filtered;
+  const auto per_s = [since_s](std::uint64_t count) { return static_cast<double>(count) / since_s; };
   if (!problems.empty()) {
     state_ = problems;
   } else if (published > 0 && since_s > 0.0) {
-    state_ = config_.lidars.size() > 1
-                 ? sprintf_text("publishing %.1f sweeps/s of %zu LiDARs (%s)", static_cast<double>(published) / since_s,
-                                config_.lidars.size(), config_.lidar_merge.per_sensor ? "each alone" : "merged")
-                 : sprintf_text("publishing %.1f sweeps/s", static_cast<double>(published) / since_s);
+    // Merged, the rate a subscriber sees is the merged sweeps' (the points_t messages), not the
+    // sensors' sweeps in them.
+    const bool merged = config_.lidars.size() > 1 && !config_.lidar_merge.per_sensor;
+    state_ = merged ? sprintf_text("publishing %.1f merged sweeps/s of %zu LiDARs (%.1f sensor sweeps/s)",
+                                   per_s(s[Counter::kMergePublished] - previous[Counter::kMergePublished]),
+                                   config_.lidars.size(), per_s(published))
+             : config_.lidars.size() > 1 ? sprintf_text("publishing %.1f sweeps/s of %zu LiDARs (each alone)",
+                                                        per_s(published), config_.lidars.size())
+                                         : sprintf_text("publishing %.1f sweeps/s", per_s(published));
   } else {
     state_ = "receiving LiDAR data, no sweep published in the last second";
   }

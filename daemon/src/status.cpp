@@ -149,6 +149,10 @@ void fill_snapshot(const pipeline::SweepProcessor& p, const Pipeline& pipeline, 
   }
   // Several LiDARs on one port: a sender that is none of theirs, dropped by the processor.
   s[C::kLidarRejectedSource] += p.counters().lidar_unknown_sender;
+  if (const pipeline::SweepMerger* merger = p.merger(); merger != nullptr) {
+    s[C::kMergePublished] = merger->published();
+    s[C::kMergeIncomplete] = merger->incomplete();
+  }
   s[C::kChronySamples] = pipeline.chrony ? pipeline.chrony->samples() : 0;
   s[C::kRingDropsSweeps] = pipeline.sweeps.dropped();
   s[C::kRingDropsStatus] = pipeline.status->dropped();

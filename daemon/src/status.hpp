@@ -84,7 +84,9 @@ struct Pipeline;
   X(kImuNmea, "imu.nmea_sentences")                                                  \
   X(kImuVnAscii, "imu.vn100_ascii_sentences")                                        \
   X(kImuRtcm3, "imu.rtcm3_frames")                                                   \
-  X(kChronySamples, "time.chrony_samples")
+  X(kChronySamples, "time.chrony_samples")                                           \
+  X(kMergePublished, "lidar_merge.published")                                        \
+  X(kMergeIncomplete, "lidar_merge.incomplete")
 
 enum class Counter : std::uint16_t {
 #define TRAJROI_COUNTER_ID(id, name) id,

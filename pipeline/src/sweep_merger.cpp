@@ -143,6 +143,7 @@ void SweepMerger::emit(SweepSink& sink) {
     if ((merged_.sensors & (1U << i)) == 0 && silent(i, now_ns_)) merged_.silent |= 1U << i;
   }
   if (merged_.missing != 0) ++incomplete_;
+  if (merged_.filtered) ++published_;
   sink.on_sweep(merged_);
   merged_.clear_points();
   merged_.sensors = 0;

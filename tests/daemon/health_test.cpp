@@ -105,6 +105,9 @@ TEST(Health, ASilentLidarOfSeveralIsNamedOnceAndInTheStateWhileItLasts) {
   for (int t = 1; t <= 6; ++t) {
     s.steady_ns = t * kSecond;
     healthy(s, t);
+    s.processor.sweeps += 10;  // two sensors at 10 Hz, their sweeps merged two by two
+    s.processor.sweeps_filtered += 10;
+    s[Counter::kMergePublished] += 10;
     s.silent_lidars = t >= 3 && t <= 4 ? 2U : 0U;
     if (t == 3) {  // the first sweep without it, before the snapshot
       for (const HealthLine& l : monitor.silent_lidars(2U))
@@ -113,7 +116,8 @@ TEST(Health, ASilentLidarOfSeveralIsNamedOnceAndInTheStateWhileItLasts) {
     for (const HealthLine& l : monitor.update(s))
       said.push_back(l.text);
     if (t == 2) {
-      EXPECT_EQ(monitor.state(), "publishing 10.0 sweeps/s of 2 LiDARs (merged)");
+      // The rate a subscriber sees, and the sensors' sweeps in it.
+      EXPECT_EQ(monitor.state(), "publishing 10.0 merged sweeps/s of 2 LiDARs (20.0 sensor sweeps/s)");
     }
     if (t == 4) {
       EXPECT_EQ(monitor.state(), "LiDAR rear (192.168.1.202 → UDP 2368): silent, not merged");
@@ -123,6 +127,23 @@ TEST(Health, ASilentLidarOfSeveralIsNamedOnceAndInTheStateWhileItLasts) {
   EXPECT_EQ(said[0].rfind("lidar: rear (192.168.1.202 → UDP 2368) silent: no sweep for more than 0.50 s", 0), 0U)
       << said[0];
   EXPECT_EQ(said[1], "lidar: rear (192.168.1.202 → UDP 2368) sends sweeps again");
+}
+
+// Published each alone, every sensor's sweep is a message: the state's rate is theirs.
+TEST(Health, SeveralLidarsPublishedEachAloneSayTheSensorsRate) {
+  DaemonConfig c = live_config();
+  DaemonConfig::Lidar rear = c.lidar;
+  rear.name = "rear";
+  rear.sensor_address = "192.168.1.202";
+  c.lidar.name = "front";
+  c.lidars = {c.lidar, rear};
+  c.lidar_merge.per_sensor = true;
+  const Said said = run(c, 3, [](StatusSnapshot& s, int t) {
+    healthy(s, t);
+    s.processor.sweeps += 10;
+    s.processor.sweeps_filtered += 10;
+  });
+  EXPECT_EQ(said.state, "publishing 20.0 sweeps/s of 2 LiDARs (each alone)");
 }
 
 TEST(Health, NoLidarDatagramsAreNamedWithThePortWithinFiveSecondsAndTheirReturnToo) {

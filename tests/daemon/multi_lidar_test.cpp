@@ -263,7 +263,9 @@ TEST_P(MultiLidar, TwoLiveSendersMergeAsTrajroiFilterKeepsEachAndASilentOneIsNam
   const std::lock_guard<std::mutex> lock(listener.mutex);
   const std::lock_guard<std::mutex> raw_lock(raw_listener.mutex);
   std::size_t both = 0, matched_front = 0, matched_rear = 0, front_alone = 0, raw_front = 0, raw_rear = 0;
+  std::size_t with_missing = 0;
   for (const auto& [index, m] : listener.points) {
+    with_missing += m.missing.empty() ? 0U : 1U;
     ASSERT_EQ(m.num_sensors, 2) << "sweep " << index;
     EXPECT_EQ(m.sensor_names, (std::vector<std::string>{"front", "rear"}));
     EXPECT_TRUE(m.pose.valid);
@@ -310,6 +312,15 @@ TEST_P(MultiLidar, TwoLiveSendersMergeAsTrajroiFilterKeepsEachAndASilentOneIsNam
   ASSERT_FALSE(listener.statuses.empty());
   EXPECT_EQ(listener.statuses.back().decode_errors, 0);
   EXPECT_GE(counter(listener.statuses.back(), "lidar.rejected_source"), 5);
+  // The merged sweeps counted as they went out: each message received, and those that went
+  // out without a sensor waited for (points_t.missing).
+  EXPECT_EQ(counter(listener.statuses.back(), "lidar_merge.published"),
+            static_cast<std::int64_t>(listener.points.size()));
+  EXPECT_EQ(counter(listener.statuses.back(), "lidar_merge.incomplete"), static_cast<std::int64_t>(with_missing));
+  EXPECT_NE(log.find("merged sweeps published " + std::to_string(listener.points.size()) + " (" +
+                     std::to_string(with_missing) + " without a sensor waited for)"),
+            std::string::npos)
+      << log;
   // The state names it too.
   bool stated = false;
   for (const trajroi::status_t& st : listener.statuses)

@@ -8,12 +8,15 @@ a partial sweep there). trajroid runs live with lidars: front and rear (told apa
 mounted apart); `trajroi view` serves the page to Debian's headless chromium; lcm-logger logs
 what trajroid published. The page must name the sensors in its legend, hold for the sweep it
 shows as many points of each sensor as the published points_t does, and with "colour by
-sensor" the pixels where it put each sensor's points must be that sensor's colour.
+sensor" the pixels where it put each sensor's points must be that sensor's colour. Its panel's
+sweeps/s is the merged sweeps' it draws (about 10), not the sensors' (about 20), and the state
+says both.
 
 Arguments: TRAJROI_CLI TRAJROID OUT_DIR (TRAJROI_DATA_DIR: the shared captures).
 Exit 0 pass, 1 fail, 77 skip."""
 
 import os
+import re
 import shutil
 import struct
 import subprocess
@@ -54,6 +57,16 @@ def played(path, plays, out):
                 f.write(struct.pack("<IIII", t // 1_000_000_000, t % 1_000_000_000, len(frame), len(frame)))
                 f.write(frame)
     return out
+
+
+STATE_RATES = re.compile(r"publishing (\d+\.\d) merged sweeps/s of 2 LiDARs \((\d+\.\d) sensor sweeps/s\)")
+
+
+def steady_pairs(samples):
+    """The (panel's sweeps/s, state match) of the samples whose status spans a whole second of
+    both sensors' sweeps (15 or more sensor sweeps/s)."""
+    matched = [(rate, STATE_RATES.match(state)) for rate, state in samples if rate is not None]
+    return [(rate, m) for rate, m in matched if m and float(m.group(2)) >= 15]
 
 
 CONFIG = """global_frame:
@@ -130,7 +143,23 @@ def main():
         stats = lambda: browser.script("return window.trajroiStats;")  # noqa: E731
         both = "var s = window.trajroiProject(400).map(function (p) { return p[2]; });" \
                "return s.indexOf(0) >= 0 && s.indexOf(1) >= 0;"
-        wait_for("sweeps of both sensors drawn", lambda: stats()["sweepsDrawn"] >= 5 and browser.script(both), 30)
+        samples = []  # the panel's sweeps/s and the state, read together, while the feeds last
+
+        def sample():
+            figure = re.search(r"sweeps/s (\d+\.\d)", browser.text("figures"))
+            samples.append((float(figure.group(1)) if figure else None, browser.text("state")))
+
+        def drawn():
+            sample()
+            return stats()["sweepsDrawn"] >= 5 and browser.script(both)
+
+        def steady():  # a status over a whole second of both sensors' sweeps
+            sample()
+            return steady_pairs(samples)
+
+        wait_for("sweeps of both sensors drawn", drawn, 30)
+        # The first status's rates span trajroid's start: a whole second of sweeps is in the next.
+        wait_for("a status over a whole second of sweeps", steady, 5)
         legend = browser.text("sensors")
         check("front" in legend and "rear" in legend, "the legend names the sensors: '%s'" % legend)
         browser.script("document.getElementById('colour-sensor').click();")
@@ -145,6 +174,16 @@ def main():
         time.sleep(0.5)  # the shown sweep is logged
     finally:
         stop_all(browser, processes)
+
+    # Two sensors of 10 sweeps/s merged: the state says 10 merged sweeps/s and 20 sensor sweeps/s,
+    # and the panel's rate is the merged one (the messages it draws).
+    pairs = steady_pairs(samples)
+    print("page: sweeps/s and state %s" % sorted(set((r, m.group(0)) for r, m in pairs)))
+    for rate, m in pairs:
+        merged, sensors = float(m.group(1)), float(m.group(2))
+        check(8.0 <= merged <= 12.0 and 18.0 <= sensors <= 22.0, "the state's rates: '%s'" % m.group(0))
+        check(abs(rate - merged) < abs(rate - sensors),
+              "the panel's sweeps/s %.1f is the merged sweeps' (%s)" % (rate, m.group(0)))
 
     # The sweep the page shows, as trajroid published it: the same points of each sensor.
     published = None

@@ -49,6 +49,13 @@ std::int64_t clock_ns(clockid_t clock) {
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
+// The status's named counter `name` (0 when it has none: an older trajroid).
+std::int64_t named_counter(const trajroi::status_t& s, std::string_view name) {
+  for (std::size_t i = 0; i < s.counter_names.size() && i < s.counter_values.size(); ++i)
+    if (s.counter_names[i] == name) return s.counter_values[i];
+  return 0;
+}
+
 struct ViewOptions {
   std::string listen = "127.0.0.1:8090";
   std::string url = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608";
@@ -224,8 +231,12 @@ class Viewer {
     double rate = std::numeric_limits<double>::quiet_NaN();
     double kept_pct = std::numeric_limits<double>::quiet_NaN();
     if (last_status_ && m->uptime_s > last_status_->uptime_s) {
-      rate = static_cast<double>(m->sweeps_published - last_status_->sweeps_published) /
-             (m->uptime_s - last_status_->uptime_s);
+      // The messages drawn: with several LiDARs, the merger's (sweeps_published counts the
+      // sensors' sweeps in them).
+      const std::int64_t merged = named_counter(*m, "lidar_merge.published");
+      const std::int64_t published = merged > 0 ? merged - named_counter(*last_status_, "lidar_merge.published")
+                                                : m->sweeps_published - last_status_->sweeps_published;
+      rate = static_cast<double>(published) / (m->uptime_s - last_status_->uptime_s);
       const auto in = m->points_in - last_status_->points_in;
       if (in > 0)
         kept_pct = 100.0 * static_cast<double>(m->points_kept - last_status_->points_kept) / static_cast<double>(in);

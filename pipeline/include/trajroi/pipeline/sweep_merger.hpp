@@ -40,6 +40,8 @@ class SweepMerger {
   [[nodiscard]] bool silent(std::size_t sensor, std::int64_t now_ns) const noexcept;
   // Sweeps that went out without a sensor that was waited for.
   [[nodiscard]] std::uint64_t incomplete() const noexcept { return incomplete_; }
+  // Sweeps that went out with points (a valid pose): the points_t messages.
+  [[nodiscard]] std::uint64_t published() const noexcept { return published_; }
   // Reserves and touches the merged sweep (Sweep::make_resident).
   void make_resident() { merged_.make_resident(); }
 
@@ -58,6 +60,7 @@ class SweepMerger {
   std::vector<std::int64_t> last_ns_;
   std::uint64_t index_ = 0;
   std::uint64_t incomplete_ = 0;
+  std::uint64_t published_ = 0;
 };
 
 }  // namespace trajroi::pipeline
