@@ -87,16 +87,22 @@ TEST(Health, AHealthyDaemonSaysNothingAndPublishes) {
   EXPECT_EQ(said.state, "publishing 10.0 sweeps/s");
 }
 
-// Several LiDARs: the state says how many and how they go out; one falling silent is named with
-// its address and port, in the log once (whether a sweep or a snapshot says it first) and in the
-// state while it lasts, and its return too.
-TEST(Health, ASilentLidarOfSeveralIsNamedOnceAndInTheStateWhileItLasts) {
+// lidars: front and rear (192.168.1.202) on the live configuration's ports.
+DaemonConfig two_lidars() {
   DaemonConfig c = live_config();
   DaemonConfig::Lidar rear = c.lidar;
   rear.name = "rear";
   rear.sensor_address = "192.168.1.202";
   c.lidar.name = "front";
   c.lidars = {c.lidar, rear};
+  return c;
+}
+
+// Several LiDARs: the state says how many and how they go out; one falling silent is named with
+// its address and port, in the log once (whether a sweep or a snapshot says it first) and in the
+// state while it lasts, and its return too.
+TEST(Health, ASilentLidarOfSeveralIsNamedOnceAndInTheStateWhileItLasts) {
+  const DaemonConfig c = two_lidars();
   HealthMonitor monitor(c, true, 0);
   StatusSnapshot s;
   s.trajectory_distance_m = std::numeric_limits<double>::quiet_NaN();
@@ -131,12 +137,7 @@ TEST(Health, ASilentLidarOfSeveralIsNamedOnceAndInTheStateWhileItLasts) {
 
 // Published each alone, every sensor's sweep is a message: the state's rate is theirs.
 TEST(Health, SeveralLidarsPublishedEachAloneSayTheSensorsRate) {
-  DaemonConfig c = live_config();
-  DaemonConfig::Lidar rear = c.lidar;
-  rear.name = "rear";
-  rear.sensor_address = "192.168.1.202";
-  c.lidar.name = "front";
-  c.lidars = {c.lidar, rear};
+  DaemonConfig c = two_lidars();
   c.lidar_merge.per_sensor = true;
   const Said said = run(c, 3, [](StatusSnapshot& s, int t) {
     healthy(s, t);
