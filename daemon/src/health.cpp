@@ -328,10 +328,10 @@ void HealthMonitor::update_state(const StatusSnapshot& s, const StatusSnapshot& 
   } else if (published > 0 && since_s > 0.0) {
     // Merged, the rate a subscriber sees is the merged sweeps' (the points_t messages), not the
     // sensors' sweeps in them.
-    const bool merged = config_.lidars.size() > 1 && !config_.lidar_merge.per_sensor;
-    state_ = merged ? sprintf_text("publishing %.1f merged sweeps/s of %zu LiDARs (%.1f sensor sweeps/s)",
-                                   per_s(s[Counter::kMergePublished] - previous[Counter::kMergePublished]),
-                                   config_.lidars.size(), per_s(published))
+    state_ = config_.merges_sweeps()
+                 ? sprintf_text("publishing %.1f merged sweeps/s of %zu LiDARs (%.1f sensor sweeps/s)",
+                                per_s(s[Counter::kMergePublished] - previous[Counter::kMergePublished]),
+                                config_.lidars.size(), per_s(published))
              : config_.lidars.size() > 1 ? sprintf_text("publishing %.1f sweeps/s of %zu LiDARs (each alone)",
                                                         per_s(published), config_.lidars.size())
                                          : sprintf_text("publishing %.1f sweeps/s", per_s(published));

@@ -196,10 +196,9 @@ void log_summary(const Pipeline& pipeline, const Publisher& publisher, std::int6
       p.points_in > 0 ? 100.0 * static_cast<double>(p.points_kept) / static_cast<double>(p.points_in) : 0.0,
       latency.quantile(0.5), latency.quantile(0.99), latency.count(), s.ring_drops(), s.lost_packets, s.decode_errors,
       // Several LiDARs merged: the sweeps above are the sensors'; these are what went out.
-      pipeline.config.lidars.size() > 1 && !pipeline.config.lidar_merge.per_sensor
-          ? fmt::format(" | merged sweeps published {} ({} without a sensor waited for)", s[Counter::kMergePublished],
-                        s[Counter::kMergeIncomplete])
-          : std::string());
+      pipeline.config.merges_sweeps() ? fmt::format(" | merged sweeps published {} ({} without a sensor waited for)",
+                                                    s[Counter::kMergePublished], s[Counter::kMergeIncomplete])
+                                      : std::string());
   log::info("cpu: sources {:.3f} s ({}; {} LiDAR packets decoded ahead), processing {:.3f} s, publishing {:.3f} s",
             static_cast<double>(pipeline.cpu_sources_ns.load()) * 1e-9, replay ? "replay reader" : "receive threads",
             s[Counter::kLidarDecodedAhead], static_cast<double>(pipeline.cpu_processing_ns.load()) * 1e-9,

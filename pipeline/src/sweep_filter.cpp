@@ -3,6 +3,7 @@
 // kept ones appended to the sweep; and the sweep's end.
 #include <algorithm>
 
+#include "columns.hpp"
 #include "processor_constants.hpp"
 #include "trajroi/pipeline/sweep_processor.hpp"
 #include "trajroi/roi/transform.hpp"
@@ -74,21 +75,15 @@ pose::PoseStatus SweepProcessor::filter_batch(Lane& lane, const vlp16::Frame& fr
       config_.buffers.max_points_per_sweep - std::min(config_.buffers.max_points_per_sweep, s.size());
   const std::size_t n = std::min(room, kept_.size());
   s.truncated += static_cast<std::uint32_t>(kept_.size() - n);
-  // Grown once, then written through pointers (push_back would store each array's end at
-  // every point: the compiler cannot tell the arrays apart).
-  const std::size_t at = s.size();
-  s.make_resident_to(at + n);
-  const auto grown = [at, n](auto& v) {
-    v.resize(at + n);
-    return v.data() + at;
-  };
-  float* const x = grown(s.x);
-  float* const y = grown(s.y);
-  float* const z = grown(s.z);
-  std::uint8_t* const intensity = grown(s.intensity);
-  std::uint8_t* const ring = grown(s.ring);
-  std::uint8_t* const return_type = grown(s.return_type);
-  std::int32_t* const time_offset_ns = grown(s.time_offset_ns);
+  // Grown once, then written through pointers.
+  s.make_resident_to(s.size() + n);
+  float* const x = grown(s.x, n);
+  float* const y = grown(s.y, n);
+  float* const z = grown(s.z, n);
+  std::uint8_t* const intensity = grown(s.intensity, n);
+  std::uint8_t* const ring = grown(s.ring, n);
+  std::uint8_t* const return_type = grown(s.return_type, n);
+  std::int32_t* const time_offset_ns = grown(s.time_offset_ns, n);
   // The sources in locals too: every byte stored may alias anything, so the compiler would
   // reload the vectors' data pointers after each one.
   const std::uint32_t* const kept = kept_.data();
@@ -106,7 +101,7 @@ pose::PoseStatus SweepProcessor::filter_batch(Lane& lane, const vlp16::Frame& fr
     time_offset_ns[k] = static_cast<std::int32_t>(p.time_offset_ns);
   }
   if (keep_indices_) {
-    std::uint32_t* const index = grown(s.point_index);
+    std::uint32_t* const index = grown(s.point_index, n);
     for (std::size_t k = 0; k < n; ++k)
       index[k] = static_cast<std::uint32_t>(first + kept[k]);
   }

@@ -3,17 +3,10 @@
 #include <algorithm>
 #include <cstring>
 
+#include "columns.hpp"
+
 namespace trajroi::pipeline {
 namespace {
-
-// `n` elements more at the end of `v`, unwritten (PointColumns' arrays do not zero what they
-// grow by); where they start.
-template <typename Array>
-auto* grown(Array& v, std::size_t n) {
-  const std::size_t at = v.size();
-  v.resize(at + n);
-  return v.data() + at;
-}
 
 // The first `n` elements of `from` after those of `to`, in one copy.
 template <typename Array>

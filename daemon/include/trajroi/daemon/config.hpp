@@ -82,6 +82,8 @@ struct DaemonConfig {
     double silent_s = 0.5;    // a sensor without a sweep this long is not waited for (and named)
     bool per_sensor = false;  // true: each sensor's sweep published alone (sensor index set)
   } lidar_merge;
+  // Several LiDARs whose sweeps go out merged (not each alone).
+  [[nodiscard]] bool merges_sweeps() const noexcept { return lidars.size() > 1 && !lidar_merge.per_sensor; }
 
   struct Serial {
     std::string device;  // empty: this stream is not used live
