@@ -22,10 +22,14 @@ void add_bounded(std::vector<double>& samples, double ms) {
 }  // namespace
 
 std::string SweepTiming::describe() const {
+  const std::string merge =
+      merge_wait_ms > 0.0
+          ? fmt::format("waiting for the other LiDARs' sweeps {:.2f} (lidar_merge.max_wait_s), ", merge_wait_ms)
+          : std::string();
   return fmt::format(
-      "{:.2f} ms from its last packet to LCM (waiting for the processing thread {:.2f}, the closing packet and "
+      "{:.2f} ms from its last packet to LCM ({}waiting for the processing thread {:.2f}, the closing packet and "
       "hand-over {:.2f}, waiting for the publisher {:.2f}, encoding {:.2f}, sending {:.2f} ms)",
-      total_ms, processing_wait_ms, closing_ms, publisher_wait_ms, encoding_ms, sending_ms);
+      total_ms, merge, processing_wait_ms, closing_ms, publisher_wait_ms, encoding_ms, sending_ms);
 }
 
 LatencyBook::LatencyBook(double warning_interval_s, bool describe_late)

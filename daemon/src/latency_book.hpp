@@ -19,11 +19,13 @@ inline constexpr double kLateSweep_ms = 5.0;
 struct SweepTiming {
   std::uint64_t index = 0;
   double total_ms = -1.0;           // < 0: no sweep yet
+  double merge_wait_ms = 0.0;       // several LiDARs: the merge waiting for sensors that did not come
   double processing_wait_ms = 0.0;  // waiting for the processing thread to take the closing packet
   double closing_ms = 0.0;          // the closing packet and the hand-over
   double publisher_wait_ms = 0.0;   // waiting in the ring for the publisher
   double encoding_ms = 0.0, sending_ms = 0.0;
-  // "12.30 ms from its last packet to LCM (waiting for the processing thread …, sending … ms)"
+  // "12.30 ms from its last packet to LCM (waiting for the processing thread …, sending … ms)";
+  // a merged sweep that waited for other LiDARs says that first.
   [[nodiscard]] std::string describe() const;
 };
 

@@ -2,6 +2,7 @@
 
 #include <poll.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -73,13 +74,19 @@ void Publisher::publish_sweep(const pipeline::Sweep& s) {
     if (!s.partial) {
       const std::int64_t sent_ns = host::monotonic_ns();
       const auto ms = [](std::int64_t from, std::int64_t to) { return static_cast<double>(to - from) * 1e-6; };
-      const SweepTiming timing{.index = s.index,
-                               .total_ms = ms(s.last_packet_arrival_ns, sent_ns),
-                               .processing_wait_ms = ms(s.last_packet_arrival_ns, s.closing_packet_start_ns),
-                               .closing_ms = ms(s.closing_packet_start_ns, s.handed_over_ns),
-                               .publisher_wait_ms = ms(s.handed_over_ns, dequeued_ns),
-                               .encoding_ms = ms(dequeued_ns, encoded_ns),
-                               .sending_ms = ms(encoded_ns, sent_ns)};
+      // A merged sweep's last packet may be a sweep older than the one that closed the window
+      // (the merge waited for a sensor): that wait is the merge's, not the processing thread's.
+      const double merge_wait_ms =
+          std::min(ms(0, s.merge_wait_ns), ms(s.last_packet_arrival_ns, s.closing_packet_start_ns));
+      const SweepTiming timing{
+          .index = s.index,
+          .total_ms = ms(s.last_packet_arrival_ns, sent_ns),
+          .merge_wait_ms = merge_wait_ms,
+          .processing_wait_ms = ms(s.last_packet_arrival_ns, s.closing_packet_start_ns) - merge_wait_ms,
+          .closing_ms = ms(s.closing_packet_start_ns, s.handed_over_ns),
+          .publisher_wait_ms = ms(s.handed_over_ns, dequeued_ns),
+          .encoding_ms = ms(dequeued_ns, encoded_ns),
+          .sending_ms = ms(encoded_ns, sent_ns)};
       latency_.add(timing, sent_ns);
     }
     // After the kept points and outside their latency: for viewers only.

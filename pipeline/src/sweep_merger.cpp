@@ -119,6 +119,7 @@ void SweepMerger::append(std::size_t sensor, const Sweep& sweep) {
     m.sensors = sensors;
   }
   m.sensors |= 1U << sensor;
+  joined_ns_ = now_ns_;
   if (!sweep.filtered) return;  // a sweep without a valid pose has no points
   const auto shift = static_cast<std::int32_t>(sweep.start_ns - m.start_ns);
   const std::size_t n = append_columns(m, sweep, capacity_, shift);
@@ -131,6 +132,7 @@ void SweepMerger::append(std::size_t sensor, const Sweep& sweep) {
 void SweepMerger::emit(SweepSink& sink) {
   merged_.index = index_++;
   merged_.missing = waited_for_ & ~merged_.sensors;
+  merged_.merge_wait_ns = std::max<std::int64_t>(0, now_ns_ - joined_ns_);
   merged_.silent = 0;
   for (std::size_t i = 0; i < last_ns_.size(); ++i) {
     if ((merged_.sensors & (1U << i)) == 0 && silent(i, now_ns_)) merged_.silent |= 1U << i;

@@ -24,6 +24,7 @@ struct Collect final : SweepSink {
     std::vector<std::uint8_t> raw_sensor;
     bool filtered;
     std::uint32_t points_in;
+    std::int64_t merge_wait_ns;
   };
   std::vector<Out> out;
   void on_sweep(Sweep& s) override {
@@ -37,7 +38,8 @@ struct Collect final : SweepSink {
                    {s.raw.time_offset_ns.begin(), s.raw.time_offset_ns.end()},
                    {s.raw_sensor_index.begin(), s.raw_sensor_index.end()},
                    s.filtered,
-                   s.points_in});
+                   s.points_in,
+                   s.merge_wait_ns});
   }
 };
 
@@ -91,6 +93,7 @@ TEST(SweepMerger, OneSweepOfEachSensorGoesOutTogetherWithEachPointsSensor) {
   EXPECT_EQ(o.raw_sensor, (std::vector<std::uint8_t>{1, 1, 0, 0, 0}));
   EXPECT_EQ(o.points_in, 10U);
   EXPECT_TRUE(o.filtered);
+  EXPECT_EQ(o.merge_wait_ns, 0);  // out as its last sweep joined
 }
 
 TEST(SweepMerger, ASensorLateByMoreThanTheWaitIsLeftOutAndNamedMissing) {
@@ -106,6 +109,8 @@ TEST(SweepMerger, ASensorLateByMoreThanTheWaitIsLeftOutAndNamedMissing) {
   EXPECT_EQ(c.out[0].sensors, 1U);
   EXPECT_EQ(c.out[0].missing, 2U);
   EXPECT_EQ(m.incomplete(), 1U);
+  // Its latency is the wait for sensor 1, not the processing's: the log line says so.
+  EXPECT_EQ(c.out[0].merge_wait_ns, 101 * kMs);
 }
 
 TEST(SweepMerger, ASilentSensorIsNotWaitedForAndIsSaidSilent) {
@@ -144,6 +149,7 @@ TEST(SweepMerger, ASecondSweepOfOneSensorClosesTheWindow) {
   ASSERT_EQ(c.out.size(), 1U);
   EXPECT_EQ(c.out[0].sensors, 3U);
   EXPECT_EQ(c.out[0].missing, 4U);
+  EXPECT_EQ(c.out[0].merge_wait_ns, 89 * kMs);  // from sensor 1's sweep to sensor 0's next
 }
 
 TEST(SweepMerger, ASweepWithoutAValidPoseAddsNoPointsButTheOthersArePublished) {

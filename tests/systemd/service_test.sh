@@ -2,7 +2,7 @@
 # trajroid under a real systemd (PID 1 of private PID, mount and network namespaces, see
 # nsd.sh), with the unit as installed. One case per run:
 #   service_test.sh CASE UNIT CONFIG_DIR TRAJROI WORK PYTHONPATH DATA_DIR
-# CASE: idle_then_stop | frozen_is_restarted | reload | bad_config | live | rtk
+# CASE: idle_then_stop | frozen_is_restarted | reload | bad_config | live | rtk | two_lidars
 set -euo pipefail
 case_name=$1 unit_file=$2 config_dir=$3 trajroi=$4 work=$5 python_path=$6 data_dir=$7
 here=$(cd "$(dirname "$0")" && pwd)
@@ -350,6 +350,11 @@ YAML
   awk -v a="$chrony_offset" -v b="$trajroid_offset" 'BEGIN { d = a + b; exit !(d < 0.05 && d > -0.05) }' ||
     fail "chronyd's offset is not trajroid's"
   grep -q "^last_rtk_solution 1" <<<"$summary" || fail "the status does not report RTK float"
+  ;;
+
+two_lidars)
+  # shellcheck source=service_two_lidars.sh
+  source "$here/service_two_lidars.sh"
   ;;
 
 *)

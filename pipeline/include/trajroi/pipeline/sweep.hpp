@@ -90,6 +90,10 @@ struct SweepHeader {
   // its time went).
   std::int64_t closing_packet_start_ns = 0;
   std::int64_t handed_over_ns = 0;
+  // Several LiDARs merged: how long (input time) the window stayed open after the last sweep
+  // that joined it, waiting for sensors whose sweeps did not come (lidar_merge.max_wait_s); 0
+  // when it went out as its last sweep joined, and for one LiDAR.
+  std::int64_t merge_wait_ns = 0;
 };
 
 // Points in the global frame as a structure of arrays (the columns of points_t).

@@ -56,6 +56,7 @@ class SweepMerger {
   std::int64_t deadline_ns_ = 0;
   std::int64_t first_input_ns_ = 0;
   std::int64_t now_ns_ = 0;       // the newest input time seen
+  std::int64_t joined_ns_ = 0;    // the input time the window's last sweep joined it
   std::uint32_t waited_for_ = 0;  // the sensors not silent when the window opened
   std::vector<std::int64_t> last_ns_;
   std::uint64_t index_ = 0;
