@@ -101,6 +101,7 @@ std::string sender_list(const StatusSnapshot& s) {
 
 HealthMonitor::HealthMonitor(const DaemonConfig& config, bool live, std::int64_t start_steady_ns)
     : config_(config), live_(live) {
+  lidar_model_said_.fill(-1);
   StatusSnapshot start;  // every counter starts at zero
   start.steady_ns = start_steady_ns;
   history_.push_back(start);
@@ -177,38 +178,9 @@ void HealthMonitor::lidar_sensors(std::uint32_t silent, std::vector<HealthLine>&
   silent_lidars_ = silent;
 }
 
-// Live only: in a replay the recording's receiver and sensor are not now.
-void HealthMonitor::clocks(const StatusSnapshot& s, std::vector<HealthLine>& out) {
-  const double gnss = s.host_minus_gnss_utc_s;
-  const double limit = config_.time.max_gnss_offset_s;
-  set(kClockOffset, live_ && std::isfinite(gnss) && std::abs(gnss) > limit,
-      sprintf_text("time: the host clock is %.3f s %s GNSS UTC (NAV-PVT, time accuracy %.3g s; more than "
-                   "time.max_gnss_offset_s %.3f s): is NTP/chrony running and synchronised?",
-                   std::abs(gnss), gnss > 0 ? "ahead of" : "behind", s.gnss_time_accuracy_s, limit),
-      sprintf_text("time: the host clock is within %.3f s of GNSS UTC", limit), out);
-  const double lidar = s.host_minus_lidar_utc_s;
-  const double lidar_limit = config_.time.max_lidar_offset_s;
-  set(kLidarClockOffset, live_ && std::isfinite(lidar) && std::abs(lidar) > lidar_limit,
-      sprintf_text("time: the host clock is %.3f s %s the VLP-16's PPS-locked UTC (more than "
-                   "time.max_lidar_offset_s %.3f s): is the host clock synchronised (chrony), and the sensor's "
-                   "GPS time right?",
-                   std::abs(lidar), lidar > 0 ? "ahead of" : "behind", lidar_limit),
-      sprintf_text("time: the host clock is within %.3f s of the VLP-16's UTC", lidar_limit), out);
-  // The VLP-16's PPS, once locked, lost: its stamps run on its own clock until it locks again.
-  const auto pps = static_cast<vlp16::PpsStatus>(static_cast<std::uint8_t>(s.lidar_pps_status));
-  if (s.lidar_pps_status >= 0 && pps == vlp16::PpsStatus::kLocked) lidar_pps_locked_once_ = true;
-  const bool lost = live_ && lidar_pps_locked_once_ && s.lidar_pps_status >= 0 && pps != vlp16::PpsStatus::kLocked;
-  set(kLidarPpsLost, lost,
-      "lidar: the VLP-16's PPS is " + std::string(vlp16::to_string(pps)) +
-          " after it had locked: its time stamps follow its own clock until it locks again (GPS receiver, antenna or "
-          "PPS wire?)",
-      "lidar: the VLP-16's PPS is locked again", out);
-}
-
 void HealthMonitor::lidar(const StatusSnapshot& s, std::vector<HealthLine>& out) {
   const StatusSnapshot& previous = history_[history_.size() - 2];
   const StatusSnapshot& base = history_.front();
-  const DaemonConfig::Lidar& l = config_.lidar;
   const double window = window_s(s);
   // Nothing at all, only from other senders, or only datagrams that are not VLP-16 packets.
   const std::uint64_t accepted = accepted_packets(s) - accepted_packets(base);
@@ -237,27 +209,36 @@ void HealthMonitor::lidar(const StatusSnapshot& s, std::vector<HealthLine>& out)
                    static_cast<unsigned long long>(not_vlp16), window, ports.c_str(), s.foreign_min_size,
                    s.foreign_max_size, sender_list(s).c_str(), key.c_str()),
       sprintf_text("lidar: VLP-16 packets arriving on UDP %s", ports.c_str()), out);
-  // The model the packets are decoded as, said once (and again should it ever change).
-  if (s.lidar_model >= 0 && s.lidar_model != lidar_model_said_) {
-    const vlp16::ModelSpec& m = vlp16::spec(static_cast<vlp16::Model>(s.lidar_model));
-    out.push_back({HealthLine::Level::kInfo,
-                   sprintf_text("lidar: %s packets (product id 0x%02X), decoded with %s (lidar.model %s)",
-                                std::string(m.name).c_str(), static_cast<unsigned>(m.product_id),
-                                l.calibration.empty() ? "its manual's geometry"
-                                                      : ("lidar.calibration " + l.calibration.string()).c_str(),
-                                l.model.c_str())});
-    lidar_model_said_ = s.lidar_model;
-  }
-  const auto unsupported = [](const StatusSnapshot& x) { return rejected(x, vlp16::PacketError::kUnsupportedProduct); };
-  if (const std::uint64_t n = unsupported(s) - unsupported(previous); n > 0) {
-    const std::string reason = s.model_reason.data();
-    out.push_back(
-        {HealthLine::Level::kWarning,
-         sprintf_text("lidar: %llu packets rejected in the last second: %s (trajroid decodes the VLP-16, Puck LITE, "
-                      "Puck Hi-Res, VLP-32C and HDL-32E; lidar.rejected.unsupported_product %llu)",
-                      static_cast<unsigned long long>(n),
-                      reason.empty() ? "not a model trajroid decodes" : reason.c_str(),
-                      static_cast<unsigned long long>(unsupported(s)))});
+  // Each LiDAR's model as its packets are decoded, said once (and again should it ever change);
+  // the packets it rejects for their model, each second.
+  const bool several = config_.lidars.size() > 1;
+  for (std::size_t i = 0; i < s.lidar_count; ++i) {
+    const StatusSnapshot::LidarFacts& f = s.lidar[i];
+    const DaemonConfig::Lidar& lane = several ? config_.lidars[i] : config_.lidar;
+    const std::string lane_key = several ? "lidars[" + std::to_string(i) + "]" : std::string("lidar");
+    if (f.model >= 0 && f.model != lidar_model_said_[i]) {
+      const vlp16::ModelSpec& m = vlp16::spec(static_cast<vlp16::Model>(f.model));
+      out.push_back(
+          {HealthLine::Level::kInfo,
+           "lidar: " + lidar_prefix(i) +
+               sprintf_text("%s packets (product id 0x%02X), decoded with %s (%s.model %s)",
+                            std::string(m.name).c_str(), static_cast<unsigned>(m.product_id),
+                            lane.calibration.empty() ? "its manual's geometry"
+                                                     : (lane_key + ".calibration " + lane.calibration.string()).c_str(),
+                            lane_key.c_str(), lane.model.c_str())});
+      lidar_model_said_[i] = f.model;
+    }
+    if (const std::uint64_t n = f.unsupported - previous.lidar[i].unsupported; n > 0) {
+      const std::string reason = f.model_reason.data();
+      out.push_back(
+          {HealthLine::Level::kWarning,
+           "lidar: " + lidar_prefix(i) +
+               sprintf_text("%llu packets rejected in the last second: %s (trajroid decodes the VLP-16, Puck LITE, "
+                            "Puck Hi-Res, VLP-32C and HDL-32E; lidar.rejected.unsupported_product %llu)",
+                            static_cast<unsigned long long>(n),
+                            reason.empty() ? "not a model trajroid decodes" : reason.c_str(),
+                            static_cast<unsigned long long>(rejected(s, vlp16::PacketError::kUnsupportedProduct)))});
+    }
   }
   if (const std::uint64_t n = s[C::kLidarClockJumps] - previous[C::kLidarClockJumps]; n > 0) {
     out.push_back(
@@ -288,6 +269,20 @@ void HealthMonitor::minute_summary(const StatusSnapshot& s, std::vector<HealthLi
   minute_start_ = s;
 }
 
+std::string HealthMonitor::rejecting_lidars(const StatusSnapshot& s, const StatusSnapshot& base) const {
+  // Each LiDAR whose packets all came rejected for their model over the window.
+  std::string text;
+  for (std::size_t i = 0; i < s.lidar_count; ++i) {
+    const StatusSnapshot::LidarFacts& f = s.lidar[i];
+    if (f.accepted != base.lidar[i].accepted || f.unsupported <= base.lidar[i].unsupported) continue;
+    const std::string reason = f.model_reason.data();
+    const std::string prefix = lidar_prefix(i);  // "" or "rear (…): "
+    text += (text.empty() ? "" : "; ") + std::string("LiDAR") + (prefix.empty() ? std::string(": ") : " " + prefix) +
+            "packets rejected: " + (reason.empty() ? std::string("not a VLP-16") : reason);
+  }
+  return text;
+}
+
 void HealthMonitor::update_state(const StatusSnapshot& s, const StatusSnapshot& previous) {
   const std::string ports = data_ports(config_);
   std::string problems;
@@ -297,11 +292,8 @@ void HealthMonitor::update_state(const StatusSnapshot& s, const StatusSnapshot& 
   } else if (active_[kLidarForeignOnly]) {
     add(sprintf_text("LiDAR: datagrams on UDP %s only from addresses other than %s", ports.c_str(),
                      sensor_addresses(config_).c_str()));
-  } else if (live_ && accepted_packets(s) == accepted_packets(history_.front()) &&
-             rejected(s, vlp16::PacketError::kUnsupportedProduct) >
-                 rejected(history_.front(), vlp16::PacketError::kUnsupportedProduct)) {
-    const std::string reason = s.model_reason.data();
-    add("LiDAR: packets rejected: " + (reason.empty() ? std::string("not a VLP-16") : reason));
+  } else if (const std::string rejecting = rejecting_lidars(s, history_.front()); live_ && !rejecting.empty()) {
+    add(rejecting);
   } else if (active_[kLidarSilent] || (live_ && accepted_packets(s) == 0)) {
     add("waiting for LiDAR data on UDP " + ports);
   }

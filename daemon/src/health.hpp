@@ -8,6 +8,7 @@
 // data on UDP port 2368; GNSS: NMEA text, no UBX, from /dev/ttyACM0", "no valid pose: newest
 // localization pose too old: …", "publishing 10.0 sweeps/s"). A mix of VLP-16 packets and
 // other datagrams on the LiDAR port is summarised once a minute.
+#include <array>
 #include <cstdint>
 #include <deque>
 #include <string>
@@ -74,8 +75,15 @@ class HealthMonitor {
   // Several LiDARs: each one that falls silent or sends again, said.
   void lidar_sensors(std::uint32_t silent, std::vector<HealthLine>& out);
   [[nodiscard]] std::string lidar_names(std::uint32_t mask) const;
-  // The host clock against GNSS time and the VLP-16's; the VLP-16's PPS.
+  // How a line names LiDAR `lane`: for one, "" and "the VLP-16's" (its model, once known);
+  // with several, "rear (10.0.0.102 → UDP 2368): " and "the rear LiDAR's (10.0.0.102 → UDP 2368)".
+  [[nodiscard]] std::string lidar_prefix(std::size_t lane) const;
+  [[nodiscard]] std::string lidar_possessive(const StatusSnapshot& s, std::size_t lane) const;
+  // The host clock against GNSS time and each LiDAR's; each LiDAR's PPS (health_clocks.cpp).
   void clocks(const StatusSnapshot& s, std::vector<HealthLine>& out);
+  // "LiDAR rear (10.0.0.102 → UDP 2368): packets rejected: <why>" for each LiDAR whose packets
+  // since `base` were all rejected for their model ("LiDAR: …" for one); "" for none.
+  [[nodiscard]] std::string rejecting_lidars(const StatusSnapshot& s, const StatusSnapshot& base) const;
   // The state in words, from the faults now active.
   void update_state(const StatusSnapshot& s, const StatusSnapshot& previous);
   // The counters' change over the window (the oldest snapshot kept to `s`).
@@ -93,9 +101,9 @@ class HealthMonitor {
   bool live_;
   std::deque<StatusSnapshot> history_;  // oldest first; the first is the all-zero start
   bool active_[kFaultCount] = {};
-  bool lidar_pps_locked_once_ = false;
-  std::int8_t lidar_model_said_ = -1;
-  std::uint32_t silent_lidars_ = 0;  // several LiDARs: those said to be silent
+  std::array<bool, kMaxLidars> lidar_pps_locked_once_{};
+  std::array<std::int8_t, kMaxLidars> lidar_model_said_{};  // -1 each (constructor): none said yet
+  std::uint32_t silent_lidars_ = 0;                         // several LiDARs: those said to be silent
   // Each serial port's fault in a few words for the state ("NMEA text, no UBX"): GNSS, IMU.
   std::string serial_state_[2];
   StatusSnapshot minute_start_;  // the mixed LiDAR port's summary

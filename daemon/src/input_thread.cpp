@@ -28,11 +28,32 @@ void copy_counters(const inputs::InputSource& source, InputLane& lane) {
 // handled before the closing packet comes and do not add to its latency.
 constexpr std::uint16_t kDrainAhead_cdeg = 500;
 
-// A LiDAR data packet that may close a sweep (vlp16::may_complete_frame), or that is at the
-// drain point ahead of the cut.
-bool wake_now(const inputs::InputItem& item, std::uint16_t cut_cdeg, std::uint16_t drain_cdeg) noexcept {
-  return item.stream == inputs::Stream::kLidarData &&
-         (vlp16::may_complete_frame(item.bytes, cut_cdeg) || vlp16::may_complete_frame(item.bytes, drain_cdeg));
+// Where the configured LiDARs cut their sweeps, each cut once, and the drain point ahead of each
+// (several LiDARs may cut at different azimuths: a rear sensor's sweep may end where a front
+// one's is halfway).
+struct Cuts {
+  std::vector<std::uint16_t> cut_cdeg, drain_cdeg;
+  explicit Cuts(const DaemonConfig& config) {
+    for (const DaemonConfig::Lidar& l : config.all_lidars()) {
+      const std::uint16_t cut = vlp16::cut_centidegrees(l.cut_azimuth_deg);
+      if (std::find(cut_cdeg.begin(), cut_cdeg.end(), cut) != cut_cdeg.end()) continue;
+      cut_cdeg.push_back(cut);
+      drain_cdeg.push_back(
+          static_cast<std::uint16_t>((cut + vlp16::kAzimuthLimit - kDrainAhead_cdeg) % vlp16::kAzimuthLimit));
+    }
+  }
+};
+
+// A LiDAR data packet that may close a sweep at one of the cuts (vlp16::may_complete_frame), or
+// that is at the drain point ahead of one.
+bool wake_now(const inputs::InputItem& item, const Cuts& cuts) noexcept {
+  if (item.stream != inputs::Stream::kLidarData) return false;
+  for (std::size_t i = 0; i < cuts.cut_cdeg.size(); ++i) {
+    if (vlp16::may_complete_frame(item.bytes, cuts.cut_cdeg[i]) ||
+        vlp16::may_complete_frame(item.bytes, cuts.drain_cdeg[i]))
+      return true;
+  }
+  return false;
 }
 
 // Decodes a LiDAR data packet ahead into the lane's ring of decoded packets, so that the
@@ -90,9 +111,7 @@ void input_loop(Pipeline& pipeline, InputLane& lane) {
   // while the processing thread sleeps).
   const auto max_batch = static_cast<int>(std::min<std::size_t>(64, std::max<std::size_t>(1, ring.capacity() / 4)));
   constexpr std::int64_t kMaxHold_ns = 20'000'000;
-  const std::uint16_t cut_cdeg = vlp16::cut_centidegrees(pipeline.config.lidar.cut_azimuth_deg);
-  const auto drain_cdeg =
-      static_cast<std::uint16_t>((cut_cdeg + vlp16::kAzimuthLimit - kDrainAhead_cdeg) % vlp16::kAzimuthLimit);
+  const Cuts cuts(pipeline.config);
   int unnotified = 0;
   std::int64_t held_since_ns = 0;
   std::uint32_t items = 0;
@@ -161,7 +180,7 @@ void input_loop(Pipeline& pipeline, InputLane& lane) {
     // An as-fast replay's processing thread that waits for input is woken at once: it would
     // idle for the batch. (A flag seen too late delays it to the batch's end, as before.)
     const bool waits = pipeline.exact && pipeline.processing_waits.load();
-    if (waits || unnotified >= max_batch || wake_now(item, cut_cdeg, drain_cdeg) ||
+    if (waits || unnotified >= max_batch || wake_now(item, cuts) ||
         (!source.ready() && host::monotonic_ns() - held_since_ns >= kMaxHold_ns)) {
       pipeline.process_wake.notify();
       unnotified = 0;

@@ -132,11 +132,13 @@ void Publisher::publish_status(const StatusSnapshot& s) {
   m.recording = pipeline_.record_dir;
   m.host_minus_gnss_utc_s = s.host_minus_gnss_utc_s;
   m.gnss_time_accuracy_s = s.gnss_time_accuracy_s;
-  m.host_minus_lidar_utc_s = s.host_minus_lidar_utc_s;
+  // The first LiDAR's (status_t has one of each; the log names every sensor's).
+  const StatusSnapshot::LidarFacts& lidar = s.lidar[0];
+  m.host_minus_lidar_utc_s = lidar.host_minus_utc_s;
   m.rtk_solution = gnss ? s.rtk : std::int8_t{-1};
-  m.lidar_pps_status = s.lidar_pps_status;
-  m.lidar_model = s.lidar_model >= 0 ? std::string(vlp16::to_string(static_cast<vlp16::Model>(s.lidar_model))) : "";
-  m.lidar_gprmc_valid = s.lidar_gprmc_valid;
+  m.lidar_pps_status = lidar.pps_status;
+  m.lidar_model = lidar.model >= 0 ? std::string(vlp16::to_string(static_cast<vlp16::Model>(lidar.model))) : "";
+  m.lidar_gprmc_valid = lidar.gprmc_valid;
   m.processing_ms_p50 = latency_.window_processing_ms(0.50);
   m.processing_ms_p99 = latency_.window_processing_ms(0.99);
   m.latency_ms_p50 = latency_.window_latency_ms(0.50);

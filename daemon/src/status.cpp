@@ -35,6 +35,24 @@ const Names& names() {
   return n;
 }
 
+void fill_lidar_facts(const pipeline::SweepProcessor& p, std::size_t lane, StatusSnapshot::LidarFacts& f) {
+  f.host_minus_utc_s = p.host_minus_lidar_utc_s(lane);
+  const vlp16::ModelCheck& model = p.lidar_stream(lane).model_check();
+  f.model = model.decided() ? static_cast<std::int8_t>(model.model()) : std::int8_t{-1};
+  const auto& position = p.lidar_position(lane);
+  f.pps_status = position ? static_cast<std::int8_t>(position->pps) : std::int8_t{-1};
+  f.gprmc_valid = !position || position->nmea != vlp16::NmeaError::kNone ? std::int8_t{-1}
+                  : position->rmc.valid                                  ? std::int8_t{1}
+                                                                         : std::int8_t{0};
+  const vlp16::StreamCounters& c = p.lidar_counters(lane);
+  f.accepted = c.data_packets - c.rejected_total();
+  f.unsupported = c.rejected[static_cast<std::size_t>(vlp16::PacketError::kUnsupportedProduct)];
+  const std::string& reason = p.lidar_model_reason(lane);
+  const std::size_t n = std::min(reason.size(), f.model_reason.size() - 1);
+  std::copy_n(reason.begin(), n, f.model_reason.begin());
+  f.model_reason[n] = '\0';
+}
+
 }  // namespace
 
 std::string_view counter_name(std::size_t index) noexcept {
@@ -50,7 +68,10 @@ std::uint64_t StatusSnapshot::ring_drops() const noexcept {
 
 void fill_snapshot(const pipeline::SweepProcessor& p, const Pipeline& pipeline, std::int64_t last_receive_ns,
                    bool final, StatusSnapshot& s) {
-  const vlp16::StreamCounters& l = p.lidar_counters();
+  // Every LiDAR's counts together; what names one sensor, each one's.
+  vlp16::StreamCounters l = p.lidar_counters();
+  for (std::size_t i = 1; i < p.lane_count(); ++i)
+    l += p.lidar_counters(i);
   s.steady_ns = host::monotonic_ns();
   s.final = final;
   s.trajectory_id = p.active_trajectory_id();
@@ -60,13 +81,9 @@ void fill_snapshot(const pipeline::SweepProcessor& p, const Pipeline& pipeline, 
   s.lost_packets = l.lost_packets;
   s.decode_errors = l.rejected_total();
   s.silent_lidars = 0;
-  for (std::size_t i = 1; i < p.lane_count(); ++i) {
-    const vlp16::StreamCounters& more = p.lidar_counters(i);
-    s.lidar_packets += more.data_packets;
-    s.position_packets += more.position_packets;
-    s.lost_packets += more.lost_packets;
-    s.decode_errors += more.rejected_total();
-  }
+  s.lidar_count = std::min(p.lane_count(), s.lidar.size());
+  for (std::size_t i = 0; i < s.lidar_count; ++i)
+    fill_lidar_facts(p, i, s.lidar[i]);
   if (const pipeline::SweepMerger* merger = p.merger(); merger != nullptr) {
     for (std::size_t i = 0; i < p.lane_count(); ++i) {
       if (merger->silent(i, p.input_time_ns())) s.silent_lidars |= 1U << i;
@@ -99,7 +116,6 @@ void fill_snapshot(const pipeline::SweepProcessor& p, const Pipeline& pipeline, 
   s.trajectory_distance_m = p.trajectory_distance_m();
   s.host_minus_gnss_utc_s = p.host_minus_gnss_utc_s();
   s.gnss_time_accuracy_s = p.gnss_time_accuracy_s();
-  s.host_minus_lidar_utc_s = p.host_minus_lidar_utc_s();
   if (const auto& pvt = p.pose_input().newest_pvt()) {
     s.rtk = static_cast<std::int8_t>(pvt->carr_soln == ublox::CarrierSolution::kFixed   ? pose::RtkSolution::kFixed
                                      : pvt->carr_soln == ublox::CarrierSolution::kFloat ? pose::RtkSolution::kFloat
@@ -107,17 +123,6 @@ void fill_snapshot(const pipeline::SweepProcessor& p, const Pipeline& pipeline, 
   } else {
     s.rtk = -1;
   }
-  const vlp16::ModelCheck& model = p.lidar_stream().model_check();
-  s.lidar_model = model.decided() ? static_cast<std::int8_t>(model.model()) : std::int8_t{-1};
-  const auto& position = p.lidar_position();
-  s.lidar_pps_status = position ? static_cast<std::int8_t>(position->pps) : std::int8_t{-1};
-  s.lidar_gprmc_valid = !position || position->nmea != vlp16::NmeaError::kNone ? std::int8_t{-1}
-                        : position->rmc.valid                                  ? std::int8_t{1}
-                                                                               : std::int8_t{0};
-  const std::string& reason = p.lidar_model_reason();
-  const std::size_t n = std::min(reason.size(), s.model_reason.size() - 1);
-  std::copy_n(reason.begin(), n, s.model_reason.begin());
-  s.model_reason[n] = '\0';
 
   s.counters.fill(0);
   s.closed_streams = 0;

@@ -136,13 +136,21 @@ struct StatusSnapshot {
   // For the fault lines (health.hpp): the robot's distance to the active trajectory at the
   // last sweep with a pose (NaN before), and the model check's last rejection ("" if none).
   double trajectory_distance_m = 0.0;
-  double host_minus_gnss_utc_s = 0.0;   // NaN: unknown
-  double gnss_time_accuracy_s = 0.0;    // its NAV-PVT tAcc (NaN: unknown)
-  double host_minus_lidar_utc_s = 0.0;  // host UTC − the VLP-16's PPS-locked UTC (NaN: unknown)
-  std::int8_t lidar_model = -1;         // vlp16::Model of the packets decoded, -1: none yet
-  std::int8_t lidar_pps_status = -1;    // vlp16::PpsStatus of the newest position packet, -1: none
-  std::int8_t lidar_gprmc_valid = -1;   // its RMC: 1 valid, 0 not, -1 none
-  std::array<char, 256> model_reason{};
+  double host_minus_gnss_utc_s = 0.0;  // NaN: unknown
+  double gnss_time_accuracy_s = 0.0;   // its NAV-PVT tAcc (NaN: unknown)
+  // Each LiDAR's own (its index in lidars:; the first is the single lidar:'s), for the lines
+  // that name one sensor: its model, its clock and PPS, its packets.
+  struct LidarFacts {
+    double host_minus_utc_s = 0.0;         // host UTC − its PPS-locked UTC (NaN: unknown)
+    std::int8_t model = -1;                // vlp16::Model of the packets decoded, -1: none yet
+    std::int8_t pps_status = -1;           // vlp16::PpsStatus of the newest position packet, -1: none
+    std::int8_t gprmc_valid = -1;          // its RMC: 1 valid, 0 not, -1 none
+    std::uint64_t accepted = 0;            // data packets decoded (not rejected)
+    std::uint64_t unsupported = 0;         // data packets rejected for their model
+    std::array<char, 192> model_reason{};  // the model check's last rejection ("" if none)
+  };
+  std::array<LidarFacts, kMaxLidars> lidar{};
+  std::size_t lidar_count = 1;
   std::array<std::uint64_t, kCounterCount> counters{};
 
   [[nodiscard]] std::uint64_t& operator[](Counter c) noexcept { return counters[static_cast<std::size_t>(c)]; }

@@ -2,149 +2,25 @@
 // per fault, with its figures, within 5 s of the fault (snapshots once a second), and one when
 // it ends; and tells systemd the state in words. The live tests (live_faults_test.cpp) show
 // the same lines from a running daemon on real bytes.
-#include "health.hpp"
-
 #include <gtest/gtest.h>
 
 #include <limits>
 #include <string>
 #include <vector>
 
+#include "health_fixture.hpp"
 #include "trajroi/inputs/input_source.hpp"
 #include "trajroi/vlp16/packet.hpp"
 
 namespace {
 
 using namespace trajroi::daemon;
-constexpr std::int64_t kSecond = 1'000'000'000;
-
-DaemonConfig live_config() {
-  DaemonConfig c;
-  c.lidar.data_port = 2368;
-  c.lidar.sensor_address = "192.168.1.201";
-  c.gnss.device = "/dev/gnss";
-  c.imu.device = "/dev/imu";
-  return c;
-}
-
-// Runs `seconds` snapshots (one a second from a start at 0), `change` making each; returns
-// every line said, and the second each first came.
-struct Said {
-  std::vector<HealthLine> lines;
-  std::vector<int> at_s;
-  std::string state;
-  [[nodiscard]] int first(const std::string& part) const {
-    for (std::size_t i = 0; i < lines.size(); ++i)
-      if (lines[i].text.find(part) != std::string::npos) return at_s[i];
-    return -1;
-  }
-  [[nodiscard]] std::string all() const {
-    std::string out;
-    for (const auto& l : lines)
-      out += l.text + "\n";
-    return out;
-  }
-};
-
-template <class Change>
-Said run(const DaemonConfig& config, int seconds, Change change, bool live = true) {
-  HealthMonitor monitor(config, live, 0);
-  StatusSnapshot s;
-  s.trajectory_distance_m = std::numeric_limits<double>::quiet_NaN();
-  s.host_minus_gnss_utc_s = std::numeric_limits<double>::quiet_NaN();
-  Said said;
-  for (int t = 1; t <= seconds; ++t) {
-    s.steady_ns = t * kSecond;
-    change(s, t);
-    for (HealthLine& l : monitor.update(s)) {
-      said.lines.push_back(std::move(l));
-      said.at_s.push_back(t);
-    }
-  }
-  said.state = monitor.state();
-  return said;
-}
-
-// A healthy second: a VLP-16's 754 data packets, GNSS and IMU frames, fixes and attitudes.
-void healthy(StatusSnapshot& s, int) {
-  s.lidar_packets += 754;
-  s.position_packets += 1;
-  s[Counter::kGnssBytes] += 1000;
-  s[Counter::kGnssFrames] += 10;
-  s[Counter::kPoseFixes] += 10;
-  s[Counter::kImuBytes] += 5000;
-  s[Counter::kImuFrames] += 40;
-  s[Counter::kPoseAttitudes] += 40;
-  s.processor.sweeps += 10;
-  s.processor.sweeps_filtered += 10;
-  s.pose_valid = true;
-  s.pose_status = trajroi::pose::PoseStatus::kValid;
-}
+using namespace trajroi::daemon::health_test;
 
 TEST(Health, AHealthyDaemonSaysNothingAndPublishes) {
   const Said said = run(live_config(), 10, healthy);
   EXPECT_TRUE(said.lines.empty()) << said.all();
   EXPECT_EQ(said.state, "publishing 10.0 sweeps/s");
-}
-
-// lidars: front and rear (192.168.1.202) on the live configuration's ports.
-DaemonConfig two_lidars() {
-  DaemonConfig c = live_config();
-  DaemonConfig::Lidar rear = c.lidar;
-  rear.name = "rear";
-  rear.sensor_address = "192.168.1.202";
-  c.lidar.name = "front";
-  c.lidars = {c.lidar, rear};
-  return c;
-}
-
-// Several LiDARs: the state says how many and how they go out; one falling silent is named with
-// its address and port, in the log once (whether a sweep or a snapshot says it first) and in the
-// state while it lasts, and its return too.
-TEST(Health, ASilentLidarOfSeveralIsNamedOnceAndInTheStateWhileItLasts) {
-  const DaemonConfig c = two_lidars();
-  HealthMonitor monitor(c, true, 0);
-  StatusSnapshot s;
-  s.trajectory_distance_m = std::numeric_limits<double>::quiet_NaN();
-  s.host_minus_gnss_utc_s = std::numeric_limits<double>::quiet_NaN();
-  std::vector<std::string> said;
-  for (int t = 1; t <= 6; ++t) {
-    s.steady_ns = t * kSecond;
-    healthy(s, t);
-    s.processor.sweeps += 10;  // two sensors at 10 Hz, their sweeps merged two by two
-    s.processor.sweeps_filtered += 10;
-    s[Counter::kMergePublished] += 10;
-    s.silent_lidars = t >= 3 && t <= 4 ? 2U : 0U;
-    if (t == 3) {  // the first sweep without it, before the snapshot
-      for (const HealthLine& l : monitor.silent_lidars(2U))
-        said.push_back(l.text);
-    }
-    for (const HealthLine& l : monitor.update(s))
-      said.push_back(l.text);
-    if (t == 2) {
-      // The rate a subscriber sees, and the sensors' sweeps in it.
-      EXPECT_EQ(monitor.state(), "publishing 10.0 merged sweeps/s of 2 LiDARs (20.0 sensor sweeps/s)");
-    }
-    if (t == 4) {
-      EXPECT_EQ(monitor.state(), "LiDAR rear (192.168.1.202 → UDP 2368): silent, not merged");
-    }
-  }
-  ASSERT_EQ(said.size(), 2U);
-  EXPECT_EQ(said[0].rfind("lidar: rear (192.168.1.202 → UDP 2368) silent: no sweep for more than 0.50 s", 0), 0U)
-      << said[0];
-  EXPECT_EQ(said[1], "lidar: rear (192.168.1.202 → UDP 2368) sends sweeps again");
-}
-
-// Published each alone, every sensor's sweep is a message: the state's rate is theirs.
-TEST(Health, SeveralLidarsPublishedEachAloneSayTheSensorsRate) {
-  DaemonConfig c = two_lidars();
-  c.lidar_merge.per_sensor = true;
-  const Said said = run(c, 3, [](StatusSnapshot& s, int t) {
-    healthy(s, t);
-    s.processor.sweeps += 10;
-    s.processor.sweeps_filtered += 10;
-  });
-  EXPECT_EQ(said.state, "publishing 20.0 sweeps/s of 2 LiDARs (each alone)");
 }
 
 TEST(Health, NoLidarDatagramsAreNamedWithThePortWithinFiveSecondsAndTheirReturnToo) {
@@ -166,43 +42,6 @@ TEST(Health, NoLidarDatagramsAreNamedWithThePortWithinFiveSecondsAndTheirReturnT
             "waiting for LiDAR data on UDP port 2368; GNSS: no bytes from /dev/gnss; IMU: no bytes from /dev/imu");
 }
 
-// With several LiDARs the lines that say nothing (or nothing right) arrives name every
-// sensor's sockets and address, not the first sensor's alone.
-TEST(Health, WithSeveralLidarsNoDatagramsNameEverySensorsPortsAndAddresses) {
-  DaemonConfig c = live_config();
-  DaemonConfig::Lidar front = c.lidar;
-  front.name = "front";
-  front.sensor_address = "127.0.0.2";
-  DaemonConfig::Lidar rear = front;
-  rear.name = "rear";
-  rear.sensor_address = "127.0.0.3";
-  rear.data_port = 2369;
-  rear.position_port = 8309;
-  DaemonConfig::Lidar top = rear;
-  top.name = "top";
-  top.sensor_address = "127.0.0.4";
-  c.lidar = front;
-  c.lidars = {front, rear, top};
-  Said said = run(c, 6, [](StatusSnapshot& s, int t) {
-    healthy(s, t);
-    s.lidar_packets -= 754, s.position_packets -= 1;
-  });
-  EXPECT_GE(said.first("lidar: no datagrams for 3 s on UDP 0.0.0.0:2368 / 8308 (front), 0.0.0.0:2369 / 8309 (rear, "
-                       "top): sensor off"),
-            1)
-      << said.all();
-  EXPECT_EQ(said.state.rfind("waiting for LiDAR data on UDP ports 2368, 2369", 0), 0U) << said.state;
-  said = run(c, 6, [](StatusSnapshot& s, int t) {
-    healthy(s, t);
-    s.lidar_packets -= 754, s.position_packets -= 1;
-    s[Counter::kLidarRejectedSource] += 754;
-  });
-  EXPECT_GE(said.first("on UDP ports 2368, 2369, none from the sensor_address of front 127.0.0.2, rear 127.0.0.3, "
-                       "top 127.0.0.4: is lidars[].sensor_address the sensor's?"),
-            1)
-      << said.all();
-}
-
 TEST(Health, DatagramsOnlyFromAnotherSenderNameTheSensorAddress) {
   const Said said = run(live_config(), 6, [](StatusSnapshot& s, int) { s[Counter::kLidarRejectedSource] += 754; });
   const int at = said.first("none from sensor_address 192.168.1.201");
@@ -216,8 +55,9 @@ TEST(Health, AnUnsupportedModelIsNamedWithTheDriversReason) {
     s.lidar_packets += 1800;  // counted, and rejected
     s.counters[static_cast<std::size_t>(Counter::kLidarRejected) +
                static_cast<std::size_t>(trajroi::vlp16::PacketError::kUnsupportedProduct) - 1] += 1800;
+    s.lidar[0].unsupported += 1800;
     const std::string reason = "product id 0x21 (HDL-32E) is not supported";
-    reason.copy(s.model_reason.data(), reason.size());
+    reason.copy(s.lidar[0].model_reason.data(), reason.size());
   });
   EXPECT_EQ(said.first("lidar: 1800 packets rejected in the last second: product id 0x21 (HDL-32E) is not supported"),
             1)
@@ -310,7 +150,8 @@ TEST(Health, AHostClockFarFromTheLidarsTimeIsWarnedAndItsReturnSaid) {
   config.time.max_lidar_offset_s = 0.05;
   const Said said = run(config, 6, [](StatusSnapshot& s, int t) {
     healthy(s, t);
-    s.host_minus_lidar_utc_s = t == 3 || t == 4 ? 0.25 : 0.01;
+    s.lidar[0].model = static_cast<std::int8_t>(trajroi::vlp16::Model::kVlp16);
+    s.lidar[0].host_minus_utc_s = t == 3 || t == 4 ? 0.25 : 0.01;
   });
   EXPECT_EQ(said.first("time: the host clock is 0.250 s ahead of the VLP-16's PPS-locked UTC (more than "
                        "time.max_lidar_offset_s 0.050 s)"),
@@ -323,7 +164,8 @@ TEST(Health, TheLidarsPpsLostAfterItHadLockedIsNamed) {
   const Said said = run(live_config(), 6, [](StatusSnapshot& s, int t) {
     healthy(s, t);
     // Synchronizing at power-up is not a loss; locked, then lost, then locked again is.
-    s.lidar_pps_status = static_cast<std::int8_t>(t == 1 ? 1 : t == 4 ? 0 : 2);
+    s.lidar[0].model = static_cast<std::int8_t>(trajroi::vlp16::Model::kVlp16);
+    s.lidar[0].pps_status = static_cast<std::int8_t>(t == 1 ? 1 : t == 4 ? 0 : 2);
   });
   EXPECT_EQ(said.first("lidar: the VLP-16's PPS is"), 4) << said.all();
   EXPECT_EQ(said.first("lidar: the VLP-16's PPS is absent after it had locked"), 4) << said.all();

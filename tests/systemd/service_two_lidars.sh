@@ -6,16 +6,21 @@
 # admits both sensors; STATUS= says the merged rate (one cloud per sweep period) beside the
 # sensors' while both send; when the rear stops while the front goes on, the journal and
 # STATUS= name it silent within a second and the front's sweeps are still published; the
-# sweeps the merge held for the rear meanwhile are late by that wait, and said so.
+# sweeps the merge held for the rear meanwhile are late by that wait, and said so. The rear then
+# sends another model's packets (a real HDL-32E capture): they are dropped, counted and named
+# with the rear, as its model was.
 pcaps=$data_dir/velodyne/vlp16
 front_capture=$pcaps/mrpt_sample_velodyne_vlp16_gps.pcap
 rear_capture=$pcaps/nebula_vlp16_dual_1673400471.DERIVED.pcap
-for f in "$front_capture" "$rear_capture"; do
+other_model=$data_dir/velodyne/other_models/mrpt_sample_velodyne_hdl32e.pcap
+for f in "$front_capture" "$rear_capture" "$other_model"; do
   [ -f "$f" ] || skip_or_fail "$f is missing (TRAJROI_DATA_DIR)"
 done
-# The front runs 6.2 s (16 plays of 0.39 s), the rear 3.2 s (8 plays of 0.40 s).
-"${PYTHON:-python3}" "$here/pcap_plays.py" "$front_capture" 16 "$work/front.pcap"
+# The front runs 9.3 s (24 plays of 0.39 s), the rear 3.2 s (8 plays of 0.40 s), then the
+# HDL-32E's packets from the rear's address 1.1 s (4 plays of 0.28 s).
+"${PYTHON:-python3}" "$here/pcap_plays.py" "$front_capture" 24 "$work/front.pcap"
 "${PYTHON:-python3}" "$here/pcap_plays.py" "$rear_capture" 8 "$work/rear.pcap"
+"${PYTHON:-python3}" "$here/pcap_plays.py" "$other_model" 4 "$work/rear_hdl32e.pcap"
 printf 'lat,lon\n50.13480,14.42995\n50.13540,14.42995\n' >"$work/trajectory.csv"
 cat >"$work/trajroid.yaml" <<YAML
 global_frame:
@@ -31,6 +36,7 @@ lidars:
     sensor_address: 10.0.0.102
     mounting: {xyz: [-0.4, -0.1, 0.7], yaw_deg: 190}
     min_range_m: 0.5
+    cut_azimuth_deg: 180
 lidar_merge: {max_wait_s: 0.15, silent_s: 0.5}
 pose:
   source: fixed
@@ -98,6 +104,18 @@ published_after_silent() {
     END { exit !(k >= 2 && n[k] > n[1]) }'
 }
 wait_for 3 published_after_silent || fail "the front's sweeps are not published after the rear fell silent"
+# Each sensor's model is named with it.
+for named in "front (10.0.0.101 → UDP 2368): VLP-16 packets (product id 0x22)" \
+  "rear (10.0.0.102 → UDP 2368): VLP-16 packets (product id 0x22)"; do
+  journal_has "lidar: $named" || fail "the model is not named with its sensor: lidar: $named"
+done
+# The rear's packets change model mid-run: dropped, counted and named with the rear.
+feed rear_hdl32e 10.0.0.102
+wait "${feeds[2]}" || fail "the rear's HDL-32E feed: $(tail -3 "$work/feed_rear_hdl32e.log")"
+rejected="lidar: rear (10.0.0.102 → UDP 2368): [0-9]* packets rejected in the last second: the sensor's packets \
+changed model mid-run, from VLP-16 to product id 0x21 (HDL-32E)"
+wait_for 3 journal_has "$rejected" || fail "the rear's packets of another model are not named with it"
+nsd journalctl -u trajroid.service --no-pager -o cat | grep -m1 "$rejected"
 wait "${feeds[0]}" || fail "the front's feed: $(tail -3 "$work/feed_front.log")"
 feeds=()
 sleep 1
@@ -106,7 +124,20 @@ nsd systemctl stop trajroid.service
 journal=$(nsd journalctl -u trajroid.service --no-pager -o cat)
 summary=$(grep "^summary:" <<<"$journal")
 echo "$summary"
+# The rear cuts its sweeps at 180°, half a turn from the front's: its closing packets are
+# handed on at once too (not held for company, up to 20 ms), so while both send, most merged
+# clouds go out within a millisecond or two of their last packet: each second's p50 (the
+# status lines after the first, until the rear falls silent).
+both_p50=$(awk -v silent="lidar: $silent" 'index($0, silent) { exit }
+  /^status: / && match($0, /latency p50 [0-9.]+/) { if (++n > 1) printf "%s ", substr($0, RSTART + 12, RLENGTH - 12) }' <<<"$journal")
+echo "each second's latency p50 while both sent: $both_p50 ms"
+[ -n "$both_p50" ] || fail "no status line while both sent"
+for p in $both_p50; do
+  awk -v p="$p" 'BEGIN { exit !(p < 2.0) }' || fail "latency p50 $p ms while both sent: the rear's closing packets wait"
+done
 [[ "$summary" == *"merged sweeps published "* ]] || fail "the summary does not count the merged sweeps"
+decode_errors=$(sed -n 's/.*decode errors \([0-9]*\).*/\1/p' <<<"$summary")
+[ "${decode_errors:-0}" -ge 500 ] || fail "the summary does not count the rear's rejected packets (the capture's 500 or more)"
 # The minute's slowest sweep is one the merge held for the rear before it was named silent
 # (up to lidar_merge.max_wait_s): its time is said to be that wait, not the processing thread's.
 slowest=$(grep "^minute:" <<<"$journal" | tail -1 | sed -n 's/.*| slowest: //p')

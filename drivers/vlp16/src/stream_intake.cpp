@@ -14,6 +14,32 @@ std::uint64_t StreamCounters::rejected_total() const noexcept {
   return total;
 }
 
+StreamCounters& StreamCounters::operator+=(const StreamCounters& o) noexcept {
+  data_packets += o.data_packets;
+  decoded_packets += o.decoded_packets;
+  decoded_ahead += o.decoded_ahead;
+  for (std::size_t e = 0; e < rejected.size(); ++e)
+    rejected[e] += o.rejected[e];
+  lost_packets += o.lost_packets;
+  out_of_order += o.out_of_order;
+  late_dropped += o.late_dropped;
+  duplicates += o.duplicates;
+  clock_resets += o.clock_resets;
+  restarts += o.restarts;
+  clock_jumps += o.clock_jumps;
+  points += o.points;
+  no_return += o.no_return;
+  out_of_range += o.out_of_range;
+  merged_returns += o.merged_returns;
+  frames += o.frames;
+  partial_frames += o.partial_frames;
+  position_packets += o.position_packets;
+  position_wrong_size += o.position_wrong_size;
+  for (std::size_t e = 0; e < nmea.size(); ++e)
+    nmea[e] += o.nmea[e];
+  return *this;
+}
+
 void StreamDecoder::on_data_packet(std::span<const std::uint8_t> payload, std::int64_t receive_time_ns, FrameSink& sink,
                                    const DecodedPacket* decoded) {
   ++counters_.data_packets;

@@ -122,8 +122,10 @@ class SweepProcessor {
   [[nodiscard]] double host_minus_gnss_utc_s() const noexcept;
   // NAV-PVT's time accuracy (tAcc) of that UTC, s (NaN: none).
   [[nodiscard]] double gnss_time_accuracy_s() const noexcept;
-  // Host UTC − the VLP-16's PPS-locked UTC at the newest sweep it stamped (NaN: none, or not locked).
-  [[nodiscard]] double host_minus_lidar_utc_s() const noexcept { return lanes_[0]->host_minus_lidar_utc_s; }
+  // Host UTC − a LiDAR's PPS-locked UTC at the newest sweep it stamped (NaN: none, or not locked).
+  [[nodiscard]] double host_minus_lidar_utc_s(std::size_t lane = 0) const noexcept {
+    return lanes_[lane]->host_minus_lidar_utc_s;
+  }
   // Ends the stream: the sweep in progress goes out (partial).
   void flush(SweepSink& sink);
   // Sweeps carry point_index from now on (the evaluations; the daemon does not need it).

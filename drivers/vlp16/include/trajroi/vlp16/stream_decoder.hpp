@@ -117,6 +117,8 @@ struct StreamCounters {
   std::array<std::uint64_t, kNmeaErrorCount> nmea{};  // by NmeaError (kNone: good RMCs)
 
   [[nodiscard]] std::uint64_t rejected_total() const noexcept;
+  // Another stream's counts added (several sensors' together).
+  StreamCounters& operator+=(const StreamCounters& other) noexcept;
 };
 
 // The cut azimuth (StreamOptions::cut_azimuth_deg, any real) in hundredths of a degree, [0, 36000).
