@@ -215,7 +215,7 @@ void HealthMonitor::lidar(const StatusSnapshot& s, std::vector<HealthLine>& out)
   for (std::size_t i = 0; i < s.lidar_count; ++i) {
     const StatusSnapshot::LidarFacts& f = s.lidar[i];
     const DaemonConfig::Lidar& lane = several ? config_.lidars[i] : config_.lidar;
-    const std::string lane_key = several ? "lidars[" + std::to_string(i) + "]" : std::string("lidar");
+    const std::string lane_key = config_.lidar_key(i);
     if (f.model >= 0 && f.model != lidar_model_said_[i]) {
       const vlp16::ModelSpec& m = vlp16::spec(static_cast<vlp16::Model>(f.model));
       out.push_back(

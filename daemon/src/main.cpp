@@ -19,6 +19,7 @@
 #include "reload.hpp"
 #include "trajroi/daemon/trajectory_file.hpp"
 #include "trajroi/daemon/unit_allow.hpp"
+#include "trajroi/pipeline/sweep_processor.hpp"
 #include "trajroid.hpp"
 
 namespace {
@@ -163,6 +164,17 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%strajroid: configuration error: %s: trajectory.file: %s: %s\n", error_prefix(),
                  config_file.c_str(), config.trajectory_file.c_str(), e.what());
     return kExitConfig;
+  }
+  // So are the LiDARs' calibration files: a malformed one, or one of another model's laser
+  // count, is a configuration error here, for --check-config too.
+  const std::vector<DaemonConfig::Lidar> lidars = config.all_lidars();
+  for (std::size_t i = 0; i < lidars.size(); ++i) {
+    try {
+      (void)trajroi::pipeline::load_calibration(lidars[i], config.lidar_key(i));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "%strajroid: configuration error: %s: %s\n", error_prefix(), config_file.c_str(), e.what());
+      return kExitConfig;
+    }
   }
   if (check_config) {
     std::printf("%s", describe(config).c_str());

@@ -33,20 +33,25 @@ double size_along(const DaemonConfig::Roi& r) {
 
 }  // namespace
 
-vlp16::Calibration load_calibration(const DaemonConfig::Lidar& lidar) {
+vlp16::Calibration load_calibration(const DaemonConfig::Lidar& lidar, const std::string& key) {
   const std::filesystem::path& file = lidar.calibration;
   const std::optional<vlp16::Model> model = vlp16::model_named(lidar.model);
   if (file.empty()) return vlp16::Calibration::for_model(model.value_or(vlp16::Model::kVlp16));
-  vlp16::Calibration calibration = vlp16::parse_calibration_file(config::read_text_file(file), file.string());
+  vlp16::Calibration calibration;
+  try {
+    calibration = vlp16::parse_calibration_file(config::read_text_file(file), file.string());
+  } catch (const std::exception& e) {
+    throw config::ConfigError(key + ".calibration: " + e.what());  // names the file and its line
+  }
   const vlp16::ModelSpec& s = vlp16::spec(model.value_or(vlp16::Model::kVlp16));
   if (!model && calibration.laser_count != s.lasers) {
-    throw config::ConfigError("lidar.calibration " + file.string() + ": " + std::to_string(calibration.laser_count) +
-                              " lasers: set lidar.model (vlp32c or hdl32e) for a 32-laser calibration");
+    throw config::ConfigError(key + ".calibration " + file.string() + ": " + std::to_string(calibration.laser_count) +
+                              " lasers: set " + key + ".model (vlp32c or hdl32e) for a 32-laser calibration");
   }
   if (calibration.laser_count != s.lasers) {
-    throw config::ConfigError("lidar.calibration " + file.string() + ": " + std::to_string(calibration.laser_count) +
-                              " lasers, but a " + std::string(s.name) + " (lidar.model " + lidar.model + ") has " +
-                              std::to_string(s.lasers));
+    throw config::ConfigError(key + ".calibration " + file.string() + ": " + std::to_string(calibration.laser_count) +
+                              " lasers, but a " + std::string(s.name) + " (" + key + ".model " + lidar.model +
+                              ") has " + std::to_string(s.lasers));
   }
   return calibration;
 }
@@ -107,16 +112,17 @@ std::uint32_t address_of(const std::string& text) {
 
 }  // namespace
 
-SweepProcessor::Lane::Lane(const DaemonConfig& config, const DaemonConfig::Lidar& l, const pose::PoseBuffer& poses)
-    : lidar(l),
-      decoder(load_calibration(l), stream_options(l)),
+SweepProcessor::Lane::Lane(const DaemonConfig& config, std::size_t i, const pose::PoseBuffer& poses)
+    : lidar(config.all_lidars()[i]),
+      index(i),
+      decoder(load_calibration(lidar, config.lidar_key(i)), stream_options(lidar)),
       firing(
-          poses, l.robot_from_lidar,
+          poses, lidar.robot_from_lidar,
           config.pose_mode == PoseMode::kPerSweep ? std::numeric_limits<std::int64_t>::max() : vlp16::kFiringCycle_ns),
       chain(config.roi.shape,
             roi::ChainSize{config.roi.circle_diameter_m / 2.0, config.roi.rect_height_m, config.roi.rect_width_m},
             roi::ZLimits{config.roi.z_min_m, config.roi.z_max_m}),
-      sender(address_of(l.sensor_address)) {}
+      sender(address_of(lidar.sensor_address)) {}
 
 SweepProcessor::SweepProcessor(const DaemonConfig& config, std::unique_ptr<ActiveTrajectory> trajectory)
     : config_(config),
@@ -131,9 +137,8 @@ SweepProcessor::SweepProcessor(const DaemonConfig& config, std::unique_ptr<Activ
   const DaemonConfig::Roi& r = config_.roi;
   const double longest = r.look_ahead_m + r.max_speed_mps * r.look_ahead_per_mps_s;
   const std::size_t centres = chain_capacity(r);
-  for (const DaemonConfig::Lidar& lidar : config_.all_lidars()) {
-    auto lane = std::make_unique<Lane>(config_, lidar, poses_);
-    lane->index = lanes_.size();
+  for (std::size_t i = 0; i < config_.all_lidars().size(); ++i) {
+    auto lane = std::make_unique<Lane>(config_, i, poses_);
     lane->sweep.reserve(config_.buffers.max_points_per_sweep, centres, raw_points_capacity(config_));
     lane->chain.reserve(centres);
     lane->chain.place(active_->trajectory, 0.0, longest, r.spacing_ratio * size_along(r),

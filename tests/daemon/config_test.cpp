@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "daemon_fixture.hpp"
+#include "test_data.hpp"
 
 namespace {
 
@@ -219,6 +220,40 @@ TEST(DaemonConfig, TheDaemonExitsWith78OnABadConfigurationAndCheckConfigPassesAG
                      "--check-config")
                 .code,
             0);
+  fs::remove_all(dir);
+}
+
+// A LiDAR's calibration file is part of the configuration: malformed, or of another model's
+// laser count, it is a configuration error naming the LiDAR's key (the second of lidars:),
+// the file and its line, for --check-config as for a start.
+TEST(DaemonConfig, ASecondLidarsBadCalibrationIsAConfigurationErrorNamingItsKeyFileAndLine) {
+  const fs::path dir = fs::temp_directory_path() / ("trajroid_calibration_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "trajectory.csv") << "0,0\n10,0\n";
+  std::ofstream(dir / "broken.yaml") << "lasers:\n  - {laser_id: 0, vert_correction: abc}\n";
+  const auto config = [&](const std::string& name, const std::string& rear_extra) {
+    std::ofstream(dir / name) << "global_frame: {origin: {lat_deg: 50, lon_deg: 14, height_m: 0}}\n"
+                                 "trajectory: {file: trajectory.csv}\n"
+                                 "lidars:\n"
+                                 "  - {name: front, sensor_address: 127.0.0.2}\n"
+                                 "  - {name: rear, sensor_address: 127.0.0.3, "
+                              << rear_extra << "}\n";
+    return dir / name;
+  };
+  const fs::path malformed = config("malformed.yaml", "calibration: broken.yaml");
+  for (const char* mode : {"--check-config", ""}) {
+    const DaemonRun r = trajroid(malformed, mode);
+    EXPECT_EQ(r.code, 78) << r.err;
+    EXPECT_NE(r.err.find("lidars[1].calibration: " + (dir / "broken.yaml").string() + ":2:"), std::string::npos)
+        << r.err;
+  }
+  TRAJROI_REQUIRE_DATA(vlp16_calibration, "velodyne/vlp16/nebula_VLP16_calibration.yaml");
+  const fs::path sixteen = config("sixteen.yaml", "model: vlp32c, calibration: " + vlp16_calibration.string());
+  for (const char* mode : {"--check-config", ""}) {
+    const DaemonRun r = trajroid(sixteen, mode);
+    EXPECT_EQ(r.code, 78) << r.err;
+    EXPECT_NE(r.err.find(": 16 lasers, but a VLP-32C (lidars[1].model vlp32c) has 32"), std::string::npos) << r.err;
+  }
   fs::remove_all(dir);
 }
 

@@ -75,6 +75,10 @@ struct DaemonConfig {
   // The LiDARs to run: `lidars` when several, else the one `lidar` holds (read from lidar:, or
   // set in code).
   [[nodiscard]] std::vector<Lidar> all_lidars() const { return lidars.size() > 1 ? lidars : std::vector<Lidar>{lidar}; }
+  // How messages name LiDAR `i`'s keys: "lidar" for one, "lidars[1]" with several.
+  [[nodiscard]] std::string lidar_key(std::size_t i) const {
+    return lidars.size() > 1 ? "lidars[" + std::to_string(i) + "]" : std::string("lidar");
+  }
   // Several LiDARs: their sweeps merged into one points_t per time window (a sensor index per
   // point), or published one by one.
   struct LidarMerge {

@@ -56,7 +56,8 @@ struct ProcessorCounters {
 // The configured calibration (lidar.calibration; the manual's values when none) and decoding
 // options (ranges, the sweep's cut azimuth): what the processor decodes with. Throws
 // config::ConfigError for a calibration file that cannot be read or parsed.
-[[nodiscard]] vlp16::Calibration load_calibration(const DaemonConfig::Lidar& lidar);
+// `key`: how its errors name the LiDAR's keys (DaemonConfig::lidar_key).
+[[nodiscard]] vlp16::Calibration load_calibration(const DaemonConfig::Lidar& lidar, const std::string& key = "lidar");
 [[nodiscard]] vlp16::StreamOptions stream_options(const DaemonConfig::Lidar& lidar);
 [[nodiscard]] inline vlp16::Calibration load_calibration(const DaemonConfig& config) {
   return load_calibration(config.lidar);
@@ -165,7 +166,8 @@ class SweepProcessor {
   // (several sensors' sweeps overlap in time: each is filtered against the chain placed at its
   // own start, for the robot's pose then).
   struct Lane {
-    Lane(const DaemonConfig& config, const DaemonConfig::Lidar& lidar, const pose::PoseBuffer& poses);
+    // LiDAR `i` of config.all_lidars().
+    Lane(const DaemonConfig& config, std::size_t i, const pose::PoseBuffer& poses);
     DaemonConfig::Lidar lidar;
     std::size_t index = 0;  // in lidars:
     vlp16::StreamDecoder decoder;
