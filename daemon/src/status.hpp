@@ -134,7 +134,7 @@ struct StatusSnapshot {
   std::uint64_t foreign_from_others = 0;
   bool final = false;  // the last one: the input has ended
   // For the fault lines (health.hpp): the robot's distance to the active trajectory at the
-  // last sweep with a pose (NaN before), and the model check's last rejection ("" if none).
+  // last sweep with a pose (NaN before), the host clock's offsets.
   double trajectory_distance_m = 0.0;
   double host_minus_gnss_utc_s = 0.0;  // NaN: unknown
   double gnss_time_accuracy_s = 0.0;   // its NAV-PVT tAcc (NaN: unknown)
@@ -147,7 +147,7 @@ struct StatusSnapshot {
     std::int8_t gprmc_valid = -1;          // its RMC: 1 valid, 0 not, -1 none
     std::uint64_t accepted = 0;            // data packets decoded (not rejected)
     std::uint64_t unsupported = 0;         // data packets rejected for their model
-    std::array<char, 192> model_reason{};  // the model check's last rejection ("" if none)
+    std::array<char, 256> model_reason{};  // the model check's last rejection ("" if none)
   };
   std::array<LidarFacts, kMaxLidars> lidar{};
   std::size_t lidar_count = 1;
