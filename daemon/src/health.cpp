@@ -150,10 +150,7 @@ std::string HealthMonitor::lidar_names(std::uint32_t mask) const {
   std::string names;
   for (std::size_t i = 0; i < config_.lidars.size(); ++i) {
     if ((mask & (1U << i)) == 0) continue;
-    const DaemonConfig::Lidar& l = config_.lidars[i];
-    names += (names.empty() ? "" : ", ") + l.name + " (" +
-             (l.sensor_address.empty() ? std::string("any sender") : l.sensor_address) + " → UDP " +
-             std::to_string(l.data_port) + ")";
+    names += (names.empty() ? "" : ", ") + config_.lidars[i].name + " (" + lidar_where(i) + ")";
   }
   return names;
 }
@@ -276,8 +273,7 @@ std::string HealthMonitor::rejecting_lidars(const StatusSnapshot& s, const Statu
     const StatusSnapshot::LidarFacts& f = s.lidar[i];
     if (f.accepted != base.lidar[i].accepted || f.unsupported <= base.lidar[i].unsupported) continue;
     const std::string reason = f.model_reason.data();
-    const std::string prefix = lidar_prefix(i);  // "" or "rear (…): "
-    text += (text.empty() ? "" : "; ") + std::string("LiDAR") + (prefix.empty() ? std::string(": ") : " " + prefix) +
+    text += (text.empty() ? "" : "; ") + (config_.lidars.size() > 1 ? "LiDAR " + lidar_prefix(i) : "LiDAR: ") +
             "packets rejected: " + (reason.empty() ? std::string("not a VLP-16") : reason);
   }
   return text;

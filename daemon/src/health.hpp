@@ -75,6 +75,8 @@ class HealthMonitor {
   // Several LiDARs: each one that falls silent or sends again, said.
   void lidar_sensors(std::uint32_t silent, std::vector<HealthLine>& out);
   [[nodiscard]] std::string lidar_names(std::uint32_t mask) const;
+  // Several LiDARs: where LiDAR `lane` sends from and to, "10.0.0.102 → UDP 2368".
+  [[nodiscard]] std::string lidar_where(std::size_t lane) const;
   // How a line names LiDAR `lane`: for one, "" and "the VLP-16's" (its model, once known);
   // with several, "rear (10.0.0.102 → UDP 2368): " and "the rear LiDAR's (10.0.0.102 → UDP 2368)".
   [[nodiscard]] std::string lidar_prefix(std::size_t lane) const;

@@ -10,16 +10,18 @@
 
 namespace trajroi::daemon {
 
+std::string HealthMonitor::lidar_where(std::size_t lane) const {
+  const DaemonConfig::Lidar& l = config_.lidars[lane];
+  return (l.sensor_address.empty() ? std::string("any sender") : l.sensor_address) + " → UDP " +
+         std::to_string(l.data_port);
+}
+
 std::string HealthMonitor::lidar_prefix(std::size_t lane) const {
   return config_.lidars.size() > 1 ? lidar_names(1U << lane) + ": " : std::string();
 }
 
 std::string HealthMonitor::lidar_possessive(const StatusSnapshot& s, std::size_t lane) const {
-  if (config_.lidars.size() > 1) {
-    const DaemonConfig::Lidar& l = config_.lidars[lane];
-    return "the " + l.name + " LiDAR's (" + (l.sensor_address.empty() ? std::string("any sender") : l.sensor_address) +
-           " → UDP " + std::to_string(l.data_port) + ")";
-  }
+  if (config_.lidars.size() > 1) return "the " + config_.lidars[lane].name + " LiDAR's (" + lidar_where(lane) + ")";
   const std::int8_t model = s.lidar[lane].model;
   return "the " + (model >= 0 ? std::string(vlp16::spec(static_cast<vlp16::Model>(model)).name) : "LiDAR") + "'s";
 }

@@ -165,18 +165,19 @@ int main(int argc, char** argv) {
                  config_file.c_str(), config.trajectory_file.c_str(), e.what());
     return kExitConfig;
   }
-  // So are the LiDARs' calibration files: a malformed one, or one of another model's laser
-  // count, is a configuration error here, for --check-config too.
-  const std::vector<DaemonConfig::Lidar> lidars = config.all_lidars();
-  for (std::size_t i = 0; i < lidars.size(); ++i) {
-    try {
-      (void)trajroi::pipeline::load_calibration(lidars[i], config.lidar_key(i));
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "%strajroid: configuration error: %s: %s\n", error_prefix(), config_file.c_str(), e.what());
-      return kExitConfig;
-    }
-  }
   if (check_config) {
+    // So are the LiDARs' calibration files (a start reads them as it builds the pipeline, with
+    // the same errors): a malformed one, or one of another model's laser count.
+    const std::vector<DaemonConfig::Lidar> lidars = config.all_lidars();
+    for (std::size_t i = 0; i < lidars.size(); ++i) {
+      try {
+        (void)trajroi::pipeline::load_calibration(lidars[i], config.lidar_key(i));
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "%strajroid: configuration error: %s: %s\n", error_prefix(), config_file.c_str(),
+                     e.what());
+        return kExitConfig;
+      }
+    }
     std::printf("%s", describe(config).c_str());
     // The devices the pose source reads that are not there now: not an error (a USB receiver
     // may come later), but said, with what the daemon will do.

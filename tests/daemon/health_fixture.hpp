@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "health.hpp"
+#include "trajroi/vlp16/packet.hpp"
 
 namespace trajroi::daemon::health_test {
 
@@ -73,6 +74,17 @@ inline void healthy(StatusSnapshot& s, int) {
   s.processor.sweeps_filtered += 10;
   s.pose_valid = true;
   s.pose_status = trajroi::pose::PoseStatus::kValid;
+}
+
+// `n` data packets of LiDAR `lidar` received and rejected for their model, the model check
+// saying `reason`: counted in the status counters and in that LiDAR's own.
+inline void reject_for_model(StatusSnapshot& s, std::size_t lidar, std::uint64_t n, const std::string& reason) {
+  s.lidar_packets += n;
+  s.counters[static_cast<std::size_t>(Counter::kLidarRejected) +
+             static_cast<std::size_t>(trajroi::vlp16::PacketError::kUnsupportedProduct) - 1] += n;
+  s.lidar[lidar].unsupported += n;
+  s.lidar[lidar].model_reason.fill('\0');
+  reason.copy(s.lidar[lidar].model_reason.data(), s.lidar[lidar].model_reason.size() - 1);
 }
 
 // lidars: front and rear (192.168.1.202) on the live configuration's ports.

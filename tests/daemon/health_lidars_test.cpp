@@ -119,14 +119,8 @@ TEST(Health, EachLidarOfSeveralIsNamedWithItsModelItsRejectedPacketsItsClockAndI
     }
     s.lidar[1].pps_status = static_cast<std::int8_t>(t == 5 ? 0 : 2);
     s.lidar[1].host_minus_utc_s = t >= 3 ? -0.25 : 0.01;
-    if (t >= 3) {  // then packets of a model trajroid does not decode
-      s.lidar_packets += 1500;
-      s.lidar[1].unsupported += 1500;
-      s.counters[static_cast<std::size_t>(Counter::kLidarRejected) +
-                 static_cast<std::size_t>(trajroi::vlp16::PacketError::kUnsupportedProduct) - 1] += 1500;
-      const std::string reason = "product id 0x63 (VLS-128) is not supported";
-      reason.copy(s.lidar[1].model_reason.data(), reason.size());
-    }
+    // then packets of a model trajroid does not decode
+    if (t >= 3) reject_for_model(s, 1, 1500, "product id 0x63 (VLS-128) is not supported");
   });
   EXPECT_EQ(said.first("lidar: front (192.168.1.201 → UDP 2368): VLP-16 packets (product id 0x22), decoded with its "
                        "manual's geometry (lidars[0].model auto)"),

@@ -52,12 +52,7 @@ TEST(Health, DatagramsOnlyFromAnotherSenderNameTheSensorAddress) {
 
 TEST(Health, AnUnsupportedModelIsNamedWithTheDriversReason) {
   const Said said = run(live_config(), 3, [](StatusSnapshot& s, int) {
-    s.lidar_packets += 1800;  // counted, and rejected
-    s.counters[static_cast<std::size_t>(Counter::kLidarRejected) +
-               static_cast<std::size_t>(trajroi::vlp16::PacketError::kUnsupportedProduct) - 1] += 1800;
-    s.lidar[0].unsupported += 1800;
-    const std::string reason = "product id 0x21 (HDL-32E) is not supported";
-    reason.copy(s.lidar[0].model_reason.data(), reason.size());
+    reject_for_model(s, 0, 1800, "product id 0x21 (HDL-32E) is not supported");  // counted, and rejected
   });
   EXPECT_EQ(said.first("lidar: 1800 packets rejected in the last second: product id 0x21 (HDL-32E) is not supported"),
             1)

@@ -51,6 +51,25 @@ install_unit() {
   done
 }
 restarted() { [ "$(show NRestarts)" -ge 1 ]; }
+# The allow-lists the unit's step set at start: its journal lines and IPAddressAllow=.
+print_allow_lists() {
+  echo "allow-lists set at start:"
+  nsd journalctl -u trajroid.service --no-pager -o cat | grep "trajroid.service: allowing" | sed 's/^/  /'
+  echo "  IPAddressAllow=$(show IPAddressAllow)"
+}
+# Whether IPAddressAllow= admits ADDRESS.
+admits() {
+  local allowed
+  allowed=" $(show IPAddressAllow) "
+  [[ "$allowed" == *" $1/32 "* || "$allowed" == *" $1 "* ]]
+}
+# The test's own background processes (PIDs added to `pids`), ended before the namespace ends.
+pids=()
+nsd_on_exit() {
+  local p
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  true
+}
 
 case $case_name in
 idle_then_stop)
@@ -225,9 +244,7 @@ YAML
   logger_pid=$!
   sleep 0.5
   nsd systemctl start trajroid.service || fail "start"
-  echo "allow-lists set at start:"
-  nsd journalctl -u trajroid.service --no-pager -o cat | grep "trajroid.service: allowing" | sed 's/^/  /'
-  echo "  IPAddressAllow=$(show IPAddressAllow)"
+  print_allow_lists
   echo "  DeviceAllow=$(show DeviceAllow | tr '\n' ' ')"
   # A new trajectory before the LiDAR starts (4 s into the feed): every sweep is filtered by it.
   sleep 1
@@ -300,12 +317,6 @@ YAML
   chmod 644 "$work"/*
   export NSD_ADDRESSES=10.0.0.50
   nsd_boot
-  pids=()
-  nsd_on_exit() {
-    local p
-    for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
-    true
-  }
   install_unit "$work/trajroid.yaml"
   nsd /usr/sbin/chronyd -Q -d -t 45 -u root -f "$work/chrony.conf" >"$work/chronyd.log" 2>&1 &
   chronyd_pid=$!
@@ -320,10 +331,8 @@ YAML
   nsd timeout -s INT 30 lcm-logger --quiet "$work/out.lcmlog" >"$work/logger.log" 2>&1 &
   pids+=($!)
   nsd systemctl start trajroid.service || fail "start"
-  echo "allow-lists set at start:"
-  nsd journalctl -u trajroid.service --no-pager -o cat | grep "trajroid.service: allowing" | sed 's/^/  /'
-  echo "  IPAddressAllow=$(show IPAddressAllow)"
-  [[ " $(show IPAddressAllow) " == *" 10.0.0.50/32 "* || " $(show IPAddressAllow) " == *" 10.0.0.50 "* ]] ||
+  print_allow_lists
+  admits 10.0.0.50 ||
     fail "the caster's address is not admitted: $(show IPAddressAllow)"
   wait_for 15 journal_has "corrections: connected to ntrip://rover:\*\*\*@10.0.0.50:2101/F9T" ||
     fail "not connected to the caster"

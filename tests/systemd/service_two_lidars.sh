@@ -49,20 +49,11 @@ YAML
 chmod 644 "$work"/*
 export NSD_ADDRESSES="10.0.0.101 10.0.0.102"
 nsd_boot
-feeds=()
-nsd_on_exit() {
-  local p
-  for p in "${feeds[@]}"; do kill "$p" 2>/dev/null || true; done
-  true
-}
 install_unit "$work/trajroid.yaml"
 nsd systemctl start trajroid.service || fail "start"
-echo "allow-lists set at start:"
-nsd journalctl -u trajroid.service --no-pager -o cat | grep "trajroid.service: allowing" | sed 's/^/  /'
-allowed=" $(show IPAddressAllow) "
-echo "  IPAddressAllow=$allowed"
+print_allow_lists
 for a in 10.0.0.101 10.0.0.102; do
-  [[ "$allowed" == *" $a/32 "* || "$allowed" == *" $a "* ]] || fail "the LiDAR at $a is not admitted: $allowed"
+  admits "$a" || fail "the LiDAR at $a is not admitted: $(show IPAddressAllow)"
 done
 for name in "front at 10.0.0.101" "rear at 10.0.0.102"; do
   journal_has "the LiDAR $name (lidars: sensor_address)" || fail "the allow-list step does not name the LiDAR $name"
@@ -70,11 +61,11 @@ done
 
 feed() {  # NAME ADDRESS
   nsd "$trajroi" feed --pcap "$work/$1.pcap" --from "$2" >"$work/feed_$1.log" 2>&1 &
-  feeds+=($!)
+  pids+=($!)
 }
 feed front 10.0.0.101
 feed rear 10.0.0.102
-rear_feed=${feeds[1]}
+rear_feed=${pids[1]}
 # While both send: the merged clouds' rate, and the sensors' (each about 10 sweeps a second).
 merged_rate='publishing \([0-9.]*\) merged sweeps/s of 2 LiDARs (\([0-9.]*\) sensor sweeps/s)'
 both_rates() {
@@ -111,13 +102,13 @@ for named in "front (10.0.0.101 → UDP 2368): VLP-16 packets (product id 0x22)"
 done
 # The rear's packets change model mid-run: dropped, counted and named with the rear.
 feed rear_hdl32e 10.0.0.102
-wait "${feeds[2]}" || fail "the rear's HDL-32E feed: $(tail -3 "$work/feed_rear_hdl32e.log")"
+wait "${pids[2]}" || fail "the rear's HDL-32E feed: $(tail -3 "$work/feed_rear_hdl32e.log")"
 rejected="lidar: rear (10.0.0.102 → UDP 2368): [0-9]* packets rejected in the last second: the sensor's packets \
 changed model mid-run, from VLP-16 to product id 0x21 (HDL-32E)"
 wait_for 3 journal_has "$rejected" || fail "the rear's packets of another model are not named with it"
 nsd journalctl -u trajroid.service --no-pager -o cat | grep -m1 "$rejected"
-wait "${feeds[0]}" || fail "the front's feed: $(tail -3 "$work/feed_front.log")"
-feeds=()
+wait "${pids[0]}" || fail "the front's feed: $(tail -3 "$work/feed_front.log")"
+pids=()
 sleep 1
 nsd systemctl stop trajroid.service
 [ "$(show Result)" = success ] || fail "result $(show Result) at stop"
