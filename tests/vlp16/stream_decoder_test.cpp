@@ -243,6 +243,60 @@ namespace {
 
 // The firmware writes 36000 for a block fired exactly at the wrap (before writing 0): that is
 // 0°, the packet is kept whole and nothing is lost (ros-drivers/velodyne, VeloView: modulo).
+// A cut between two packets (at 359.95°: after the last firing of a turn's last packet, 0.4° of
+// firings ending at 359.925°, before the next packet's first at 0°): the frame is delivered with
+// that last packet, not when the next one comes; its points are those of a frame cut there.
+TEST(Vlp16Stream, AFrameWhoseCutFallsBetweenPacketsComesWithItsLastPacket) {
+  StreamOptions options;
+  options.cut_azimuth_deg = 359.95;
+  Sensor sensor;
+  StreamDecoder decoder(Calibration::vlp16_default(), options);
+  Collector sink;
+  std::vector<std::size_t> during;  // the packet each frame came with
+  for (std::size_t i = 0; i < 3 * kPacketsPerTurn; ++i) {
+    decoder.on_data_packet(sensor.next(), sensor.received(), sink);
+    while (during.size() < sink.frames.size())
+      during.push_back(i);
+  }
+  decoder.flush(sink);
+  ASSERT_EQ(sink.frames.size(), 3u);  // the first (partial) and two whole; nothing left to flush
+  for (std::size_t f = 0; f < 3; ++f)
+    EXPECT_EQ(during[f], (f + 1) * kPacketsPerTurn - 1) << "frame " << f << ": a turn's last packet";
+  EXPECT_EQ(sink.frames[1].points.size(), kPacketsPerTurn * 384);
+  EXPECT_FALSE(sink.frames[1].partial);
+  EXPECT_FALSE(sink.frames[2].partial);
+  const auto phase = [](const Point& p) { return std::fmod(static_cast<double>(p.azimuth_deg) + 0.05, 360.0); };
+  EXPECT_LT(phase(sink.frames[1].points.front()), 0.1);
+  EXPECT_GT(phase(sink.frames[1].points.back()), 359.9);
+}
+
+// A motor slower than foreseen: the packet after a foreseen end still fires 0.02° before the
+// cut. Those firings begin the next frame: none is lost, and no frame of a few points is cut
+// off them (the wrap that follows is not taken for another end).
+TEST(Vlp16Stream, FiringsBeforeTheCutAfterAForeseenEndBeginTheNextFrame) {
+  StreamOptions options;
+  options.cut_azimuth_deg = 359.95;
+  const Outcome clean = run(Sensor{}, 3 * kPacketsPerTurn, options);
+  Sensor slipped;
+  StreamDecoder decoder(Calibration::vlp16_default(), options);
+  Collector sink;
+  for (std::size_t i = 0; i < 3 * kPacketsPerTurn; ++i) {
+    if (i == kPacketsPerTurn) slipped.azimuth_cdeg = 35993;  // foreseen at 359.97°, comes at 359.93°
+    decoder.on_data_packet(slipped.next(), slipped.received(), sink);
+  }
+  decoder.flush(sink);
+  ASSERT_EQ(sink.frames.size(), clean.sink.frames.size());
+  std::size_t points = 0;
+  for (const Frame& f : sink.frames)
+    points += f.points.size();
+  EXPECT_EQ(points, 3 * kPacketsPerTurn * 384);
+  EXPECT_EQ(decoder.counters().late_dropped, 0u);
+  EXPECT_EQ(sink.frames[0].points.size(), clean.sink.frames[0].points.size());  // delivered at its foreseen end
+  // The next frame: the firing's 3 points before the cut (lasers 0–2 at 359.93–359.947°), then a turn.
+  EXPECT_FALSE(sink.frames[1].partial);
+  EXPECT_EQ(sink.frames[1].points.size(), kPacketsPerTurn * 384 + 3);
+}
+
 TEST(Vlp16Stream, ABlockAzimuthOf36000IsZeroNotALostPacket) {
   const Outcome clean = run(Sensor{}, 3 * kPacketsPerTurn);
   const Outcome r = run(Sensor{}, 3 * kPacketsPerTurn, {}, [](std::size_t i, std::vector<std::uint8_t>& p) {

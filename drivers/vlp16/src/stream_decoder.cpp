@@ -154,6 +154,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
     first_frame_ = true;
     have_last_ = false;
     have_phase_ = false;
+    cut_foreseen_ = false;
     rate_cdeg_per_us_ = 0.0;
   }
   if (have_last_) {
@@ -202,6 +203,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
       frame_.lost_packets += lost_before;
       finish_frame(sink, false);
       have_phase_ = false;
+      cut_foreseen_ = false;
       frame_.lost_packets += lost - lost_before;
     } else {
       frame_.lost_packets += lost;
@@ -256,7 +258,10 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
     }
     const double phase = phase_deg(points[i].azimuth_deg, options_.cut_azimuth_deg);
     std::int64_t t = time_ns + points[i].time_offset_ns;
-    const bool cut = have_phase && phase < last_phase_deg - 180.0;
+    // After a foreseen end the frame is closed already: the wrap past the cut is no new one,
+    // and firings still before the cut (the motor slower than foreseen) begin the next frame.
+    const bool cut = have_phase && phase < last_phase_deg - 180.0 && !cut_foreseen_;
+    if (phase < 180.0) cut_foreseen_ = false;
     if (cut || (i > 0 && t - frame_.start_time_ns > kMaxFrameDuration_ns)) {
       carried_.assign(points.begin() + static_cast<std::ptrdiff_t>(i), points.end());
       points.resize(i);
@@ -290,6 +295,21 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   have_phase_ = have_phase;
   if (!counted) ++frame_.packets;
   report_points(sink);
+  // The cut between this packet and the next: the frame is whole now, not a packet later.
+  const auto last_azimuth = static_cast<std::uint16_t>(block_azimuth(packet, last_firing_block) % kAzimuthLimit);
+  if (next_packet_past_cut(last_azimuth, span_cdeg / static_cast<double>(kBlocks / step - 1))) {
+    finish_frame(sink, false);
+    cut_foreseen_ = true;
+  }
+}
+
+bool StreamDecoder::next_packet_past_cut(std::uint16_t last_azimuth_cdeg, double step_cdeg) const noexcept {
+  if (!have_phase_ || frame_.points.empty() || !(step_cdeg > 0.0) || step_cdeg > kMaxForeseenStep_cdeg) return false;
+  // The next packet's first firing, a block step on, less the margin: its every point is at or
+  // past that azimuth (a firing's points are at or after its block's azimuth).
+  const double next_cdeg = static_cast<double>(last_azimuth_cdeg) + step_cdeg - kForesightMargin_cdeg;
+  const double next_phase = phase_deg(static_cast<float>(wrapped_deg(next_cdeg / 100.0)), options_.cut_azimuth_deg);
+  return next_phase < last_phase_deg_ - 180.0;
 }
 
 PacketDecoder::Result StreamDecoder::decode_onto_frame(std::span<const std::uint8_t> packet,
@@ -363,6 +383,7 @@ void StreamDecoder::flush(FrameSink& sink) {
   held_.clear();
   finish_frame(sink, true);
   have_phase_ = false;
+  cut_foreseen_ = false;
 }
 
 }  // namespace trajroi::vlp16

@@ -16,6 +16,16 @@
 // two clocks part by more than kClockResetThreshold_ns. When position packets carry a valid RMC
 // with the PPS locked, frames also carry their start in UTC.
 //
+// The end of a frame. A frame ends where a point's firing azimuth passes the cut. Where the cut
+// falls between two packets (after the last firing of one, before the first of the next), the
+// frame is whole with the first of them, and it is delivered then, not when the next comes: the
+// next packet's first firing is foreseen a block step on (the step measured inside the packet),
+// less kForesightMargin_cdeg. On a real sensor the step moves by at most 2 hundredths of a
+// degree between packets; a next packet that still has firings before the cut (a motor slowing
+// by more than the margin in one packet) begins the next frame with them: nothing is lost and
+// no frame is cut short. A packet that comes out of order after its frame was delivered is
+// dropped and counted, as after any frame's end.
+//
 // Sequence. A timestamp step beyond 1.5 × the packet period (1327.1 µs single, 663.6 µs
 // dual), or, with a normal step, an azimuth advance beyond 1.5 × the expected one, counts
 // the packets in between as lost. A packet older than the previous one is counted out of
@@ -51,6 +61,11 @@ inline constexpr std::int64_t kClockWindow_ns = 5'000'000'000;
 // A frame is cut after this long even without an azimuth wrap (a stalled motor): ten times
 // the slowest sweep (5 Hz).
 inline constexpr std::int64_t kMaxFrameDuration_ns = 2'000'000'000;
+// The next packet's first firing is foreseen this much short of a block step past the last
+// firing's azimuth (the end of a frame, above); no end is foreseen from a block step over
+// kMaxForeseenStep_cdeg (faster than any model turns: the packet's azimuths are not a rotation).
+inline constexpr double kForesightMargin_cdeg = 3.0;
+inline constexpr double kMaxForeseenStep_cdeg = 100.0;
 
 struct StreamOptions {
   DecodeOptions decode;
@@ -203,6 +218,9 @@ class StreamDecoder {
   std::int64_t settle_anchor(std::int64_t receive_time_ns) noexcept;
   void finish_frame(FrameSink& sink, bool partial);
   void report_points(FrameSink& sink);
+  // Whether the next packet's every firing is past the cut, foreseen from the last firing's
+  // azimuth and the block step (see "The end of a frame").
+  [[nodiscard]] bool next_packet_past_cut(std::uint16_t last_azimuth_cdeg, double step_cdeg) const noexcept;
 
   std::array<std::unique_ptr<PacketDecoder>, kModelCount> decoders_;  // options_.model's, and with
                                                                       // detect_model every model's
@@ -233,6 +251,7 @@ class StreamDecoder {
   std::int64_t window_start_ns_ = 0;
   double last_phase_deg_ = 0.0;  // of the last point placed, from the cut azimuth
   bool have_phase_ = false;
+  bool cut_foreseen_ = false;  // the frame was delivered at a foreseen end; no point past the cut yet
 
   Frame frame_;
   std::size_t reported_ = 0;  // points of frame_ handed to on_points
