@@ -241,11 +241,9 @@ TEST(Vlp16Stream, DamagedPacketsAreCountedByReasonAndTheRestDecoded) {
 namespace trajroi::vlp16 {
 namespace {
 
-// The firmware writes 36000 for a block fired exactly at the wrap (before writing 0): that is
-// 0°, the packet is kept whole and nothing is lost (ros-drivers/velodyne, VeloView: modulo).
-// A cut between two packets (at 359.95°: after the last firing of a turn's last packet, 0.4° of
-// firings ending at 359.925°, before the next packet's first at 0°): the frame is delivered with
-// that last packet, not when the next one comes; its points are those of a frame cut there.
+// A cut between two packets (at 359.95°: blocks 0.4° apart, a turn's last firing ends at
+// 359.925° and the next packet's first is at 0°): the frame is delivered with the turn's last
+// packet, not when the next one comes; its points are those of a frame cut there.
 TEST(Vlp16Stream, AFrameWhoseCutFallsBetweenPacketsComesWithItsLastPacket) {
   StreamOptions options;
   options.cut_azimuth_deg = 359.95;
@@ -297,6 +295,8 @@ TEST(Vlp16Stream, FiringsBeforeTheCutAfterAForeseenEndBeginTheNextFrame) {
   EXPECT_EQ(sink.frames[1].points.size(), kPacketsPerTurn * 384 + 3);
 }
 
+// The firmware writes 36000 for a block fired exactly at the wrap (before writing 0): that is
+// 0°, the packet is kept whole and nothing is lost (ros-drivers/velodyne, VeloView: modulo).
 TEST(Vlp16Stream, ABlockAzimuthOf36000IsZeroNotALostPacket) {
   const Outcome clean = run(Sensor{}, 3 * kPacketsPerTurn);
   const Outcome r = run(Sensor{}, 3 * kPacketsPerTurn, {}, [](std::size_t i, std::vector<std::uint8_t>& p) {

@@ -20,11 +20,12 @@
 // falls between two packets (after the last firing of one, before the first of the next), the
 // frame is whole with the first of them, and it is delivered then, not when the next comes: the
 // next packet's first firing is foreseen a block step on (the step measured inside the packet),
-// less kForesightMargin_cdeg. On a real sensor the step moves by at most 2 hundredths of a
-// degree between packets; a next packet that still has firings before the cut (a motor slowing
-// by more than the margin in one packet) begins the next frame with them: nothing is lost and
-// no frame is cut short. A packet that comes out of order after its frame was delivered is
-// dropped and counted, as after any frame's end.
+// less kForesightMargin_cdeg (on the real captures of the shared data set the next packet's
+// first block never came more than 2 hundredths of a degree before the foreseen azimuth). A
+// next packet that still has firings before the cut (a motor slowing by more than the margin
+// in one packet) begins the next frame with them: nothing is lost and no frame is cut short.
+// A packet that comes out of order after its frame was delivered is dropped and counted, as
+// after any frame's end.
 //
 // Sequence. A timestamp step beyond 1.5 × the packet period (1327.1 µs single, 663.6 µs
 // dual), or, with a normal step, an azimuth advance beyond 1.5 × the expected one, counts
