@@ -329,31 +329,48 @@ TEST_P(MultiLidar, TwoLiveSendersMergeAsTrajroiFilterKeepsEachAndASilentOneIsNam
   EXPECT_TRUE(stated) << log;
 
   // The recording replayed as fast as possible: the same merged sweeps, each sensor's points
-  // where the live run had them (the recorded senders and ports route them).
-  Listener replayed(rig.prefix + "_R");
-  ASSERT_TRUE(replayed.good());
-  std::string replay_config = slurp(rig.config);
-  for (const char* channel : {"_POINTS", "_POSE", "_ROI", "_STATUS", "_TRAJECTORY", "_POSE_INPUT", "_RAW_POINTS"}) {
-    const std::string name = rig.prefix + channel;
-    replay_config.replace(replay_config.find(name), name.size(), rig.prefix + "_R" + channel);
+  // where the live run had them (the recorded senders and ports route them). Such a replay sends
+  // its sweeps within tens of milliseconds, some megabytes: on a loaded machine (ctest -j) this
+  // test's own listener may miss some (UDP, its socket's buffer full) though trajroid sent them
+  // all. Its summary says how many it sent; a replay whose sweeps did not all arrive is run
+  // again, on channels of its own, at most three times.
+  std::size_t same = 0, received = 0;
+  std::string replay_log;
+  for (int attempt = 1; attempt <= 3; ++attempt) {
+    const std::string prefix = rig.prefix + "_R" + std::to_string(attempt);
+    Listener replayed(prefix);
+    ASSERT_TRUE(replayed.good());
+    std::string replay_config = slurp(rig.config);
+    for (const char* channel : {"_POINTS", "_POSE", "_ROI", "_STATUS", "_TRAJECTORY", "_POSE_INPUT", "_RAW_POINTS"}) {
+      const std::string name = rig.prefix + channel;
+      replay_config.replace(replay_config.find(name), name.size(), prefix + channel);
+    }
+    std::ofstream(rig.dir / "replay.yaml") << replay_config;
+    Child replay(
+        {"--config", (rig.dir / "replay.yaml").string(), "--replay", recording.string(), "--lcm-url", kTestLcmUrl},
+        rig.dir / "replay.log");
+    ASSERT_EQ(replay.wait(seconds(30)), 0) << slurp(rig.dir / "replay.log");
+    std::this_thread::sleep_for(milliseconds(300));
+    replay_log = slurp(rig.dir / "replay.log");
+    const std::lock_guard<std::mutex> replay_lock(replayed.mutex);
+    received = replayed.points.size();
+    same = 0;
+    for (const auto& [index, m] : listener.points) {
+      const auto it = replayed.points.find(index);
+      if (it == replayed.points.end()) continue;
+      same += it->second.sensor == m.sensor && it->second.x == m.x && it->second.missing == m.missing ? 1U : 0U;
+    }
+    std::printf("[ multi lidar ] replayed (attempt %d): %zu sweeps received, %zu equal to the live run's\n", attempt,
+                received, same);
+    if (replay_log.find("merged sweeps published " + std::to_string(received) + " (") != std::string::npos) break;
   }
-  std::ofstream(rig.dir / "replay.yaml") << replay_config;
-  Child replay(
-      {"--config", (rig.dir / "replay.yaml").string(), "--replay", recording.string(), "--lcm-url", kTestLcmUrl},
-      rig.dir / "replay.log");
-  ASSERT_EQ(replay.wait(seconds(30)), 0) << slurp(rig.dir / "replay.log");
-  std::this_thread::sleep_for(milliseconds(300));
-  const std::lock_guard<std::mutex> replay_lock(replayed.mutex);
-  std::size_t same = 0;
-  for (const auto& [index, m] : listener.points) {
-    const auto it = replayed.points.find(index);
-    if (it == replayed.points.end()) continue;
-    same += it->second.sensor == m.sensor && it->second.x == m.x && it->second.missing == m.missing ? 1U : 0U;
-  }
-  std::printf("[ multi lidar ] replayed: %zu sweeps, %zu equal to the live run's\n", replayed.points.size(), same);
-  // (Two sockets: two senders' datagrams within a millisecond may be taken live in another order
-  // than their recorded times at a window's edge.)
-  EXPECT_GE(same + 2, listener.points.size()) << slurp(rig.dir / "replay.log");
+  // As many merged sweeps as live, and each as live. (Two sockets: two senders' datagrams
+  // within a millisecond may be taken live in another order than their recorded times at a
+  // window's edge.)
+  EXPECT_NE(replay_log.find("merged sweeps published " + std::to_string(listener.points.size()) + " ("),
+            std::string::npos)
+      << replay_log;
+  EXPECT_GE(same + 2, listener.points.size()) << replay_log;
 }
 
 INSTANTIATE_TEST_SUITE_P(Ports, MultiLidar, testing::Values(true, false),
