@@ -214,7 +214,8 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   last_receive_ns_ = receive_time_ns;
   last_first_azimuth_ = first_azimuth;
   const std::size_t last_firing_block = kBlocks - step;
-  const std::uint32_t span_cdeg = azimuth_gap(first_azimuth, block_azimuth(packet, last_firing_block));
+  const auto last_firing_azimuth = static_cast<std::uint16_t>(block_azimuth(packet, last_firing_block) % kAzimuthLimit);
+  const std::uint32_t span_cdeg = azimuth_gap(first_azimuth, last_firing_azimuth);
   rate_cdeg_per_us_ = static_cast<double>(span_cdeg) / (static_cast<double>(kBlocks / step - 1) * block_us);
 
   product_id_ = vlp16::product_id(packet);
@@ -296,8 +297,7 @@ void StreamDecoder::accept(std::span<const std::uint8_t> packet, std::int64_t re
   if (!counted) ++frame_.packets;
   report_points(sink);
   // The cut between this packet and the next: the frame is whole now, not a packet later.
-  const auto last_azimuth = static_cast<std::uint16_t>(block_azimuth(packet, last_firing_block) % kAzimuthLimit);
-  if (next_packet_past_cut(last_azimuth, span_cdeg / static_cast<double>(kBlocks / step - 1))) {
+  if (next_packet_past_cut(last_firing_azimuth, rate_cdeg_per_us_ * block_us)) {
     finish_frame(sink, false);
     cut_foreseen_ = true;
   }
