@@ -274,6 +274,12 @@ std::vector<ConfigKey> make_keys() {
   k.push_back(flag_key(
       "realtime.lock_memory", "mlockall; needs CAP_IPC_LOCK or LimitMEMLOCK (systemd/realtime.conf)",
       [](auto& c) -> auto& { return c.realtime.lock_memory; }));
+  k.push_back(flag_key(
+      "realtime.publish_from_processing",
+      "live: the processing thread publishes the sweep it finished itself while the publisher thread is idle (no "
+      "thread to wake between a sweep's last packet and its message); false: the publisher thread publishes every "
+      "sweep",
+      [](auto& c) -> auto& { return c.realtime.publish_from_processing; }));
   k.push_back(thread_key("realtime.threads.lidar",
                          "the LiDAR input thread, e.g. {policy: fifo, priority: 60, cpus: [1]}",
                          &DaemonConfig::Realtime::lidar));

@@ -135,6 +135,16 @@ struct TrajectoryItem {
   std::unique_ptr<pipeline::ActiveTrajectory> trajectory;
 };
 
+// Publishes the sweeps waiting in Pipeline::sweeps on the calling thread, unless another thread
+// publishes now (then false: they wait for it). The Publisher is one (publisher.cpp).
+class SweepHandOver {
+ public:
+  [[nodiscard]] virtual bool publish_here() = 0;
+
+ protected:
+  ~SweepHandOver() = default;
+};
+
 struct StatusSnapshot;
 class CorrectionsLink;
 class ChronyShm;
@@ -176,6 +186,10 @@ struct Pipeline {
   EventFd process_wake, publish_wake, record_wake, main_wake;
   std::vector<std::unique_ptr<InputLane>> inputs;
   Lane<pipeline::Sweep> sweeps;
+  // Live (not exact) with realtime.publish_from_processing: the processing thread publishes a
+  // sweep it finished itself through this when the publisher thread is idle, rather than wake
+  // that thread (set before the threads start; else null: the publisher thread publishes all).
+  SweepHandOver* hand_over = nullptr;
   std::unique_ptr<Ring<StatusSnapshot>> status;
   Ring<TrajectoryItem> trajectories_in;     // publisher → processing
   Ring<TrajectoryItem> trajectories_out;    // processing → publisher (to free)

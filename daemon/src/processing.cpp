@@ -19,7 +19,9 @@ namespace {
 constexpr std::int64_t kSecond_ns = 1'000'000'000;
 
 // Hands each finished sweep to the publisher's ring (its points exchanged with a preallocated
-// slot's) with the processing time it took.
+// slot's) with the processing time it took, and sends it on: published here, at once, when
+// the publisher thread is idle (Pipeline::hand_over: no second thread to wake, which on a VM
+// waits for the host to run a halted vCPU), else that thread is woken for it.
 class RingSink final : public pipeline::SweepSink {
  public:
   explicit RingSink(Pipeline& pipeline) : pipeline_(pipeline) {}
@@ -32,9 +34,11 @@ class RingSink final : public pipeline::SweepSink {
       slot.handed_over_ns = now;
     };
     // An as-fast-as-possible replay waits for the publisher (exact output); live drops.
-    if (pipeline_.sweeps.push(fill)) pipeline_.publish_wake.notify();
+    if (pipeline_.sweeps.push(fill)) {
+      if (pipeline_.hand_over == nullptr || !pipeline_.hand_over->publish_here()) pipeline_.publish_wake.notify();
+    }
     accumulated_ns_ = 0;
-    packet_start_ns_ = now;
+    packet_start_ns_ = host::monotonic_ns();  // the next sweep's processing starts after the publishing
   }
   void packet_started(std::int64_t now) noexcept { packet_start_ns_ = now; }
   void packet_done(std::int64_t now) noexcept { accumulated_ns_ += now - packet_start_ns_; }

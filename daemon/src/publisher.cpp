@@ -55,6 +55,16 @@ Publisher::Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, boo
         "(trajroid --unit-drop-in); otherwise check the multicast route and the firewall",
         config_.lcm.trajectory);
   }
+  // An as-fast replay keeps the threads apart: there the publisher runs beside the processing
+  // thread on the other core, and nothing waits for a wake-up.
+  if (!pipeline_.exact && config_.realtime.publish_from_processing) pipeline_.hand_over = this;
+}
+
+bool Publisher::publish_here() {
+  const std::unique_lock lock(publishing_, std::try_to_lock);
+  if (!lock.owns_lock()) return false;
+  publish_pending_sweeps();
+  return true;
 }
 
 void Publisher::publish_sweep(const pipeline::Sweep& s) {
@@ -209,12 +219,17 @@ void Publisher::run() {
     log::warn("{}", w);
   }
   const std::int64_t cpu_start = host::thread_cpu_ns();
-  if (!pipeline_.exact) sender_.make_resident();
+  if (!pipeline_.exact) {
+    const std::lock_guard lock(publishing_);
+    sender_.make_resident();
+  }
   bool final_seen = false;
   for (;;) {
     pipeline_.publishing_beat.fetch_add(1, std::memory_order_relaxed);
     pollfd fds[2] = {{outlet_.incoming_fd(), POLLIN, 0}, {pipeline_.publish_wake.fd(), POLLIN, 0}};
-    if (poll(fds, 2, kIdleWait_ms) > 0) {
+    const bool woken = poll(fds, 2, kIdleWait_ms) > 0;
+    const std::lock_guard lock(publishing_);
+    if (woken) {
       if ((fds[0].revents & POLLIN) != 0) outlet_.handle_incoming();
       if ((fds[1].revents & POLLIN) != 0) pipeline_.publish_wake.drain();
     }

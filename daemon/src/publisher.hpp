@@ -5,7 +5,13 @@
 // each have a type of their own: MessageSender (encode and send), TrajectoryIntake (trajectory
 // messages and reloads), LatencyBook (latency, late sweeps), HealthMonitor (faults and
 // systemd's STATUS=), MinuteLine (the minute's line); this class runs the loop and wires them.
+//
+// Live, the processing thread may publish the sweep it just finished itself (publish_here,
+// realtime.publish_from_processing): that state then has one owner at a time, whichever
+// thread holds the publishing lock; the publisher thread holds it while it works and lets go
+// while it waits.
 #include <cstdint>
+#include <mutex>
 
 #include "corrections_watch.hpp"
 #include "health.hpp"
@@ -23,13 +29,15 @@
 
 namespace trajroi::daemon {
 
-class Publisher {
+class Publisher final : public SweepHandOver {
  public:
   // `replay`: said in the status message. `reloader` may be null (no SIGHUP reloads).
   // `trajectory`: the one active at start (published on lcm.channels.active_trajectory).
   Publisher(Pipeline& pipeline, Outlet& outlet, Reloader* reloader, bool replay,
             const pipeline::ActiveTrajectory& trajectory);
   void run();
+  // The processing thread: the sweeps waiting go out on it if the publisher thread is idle.
+  [[nodiscard]] bool publish_here() override;
 
   // After run(): the last status and the whole run's latency, for the summary.
   [[nodiscard]] const StatusSnapshot& last_status() const noexcept { return last_status_; }
@@ -45,6 +53,9 @@ class Publisher {
   // ", RTK fixed | corrections: streaming from …, age 0.4 s, 530 B/s" ("" without either).
   [[nodiscard]] std::string rtk_text(const trajroi::status_t& m) const;
 
+  // Held by the thread that publishes (everything below is its); the publisher thread's
+  // waits are outside it.
+  std::mutex publishing_;
   Pipeline& pipeline_;
   Outlet& outlet_;
   bool replay_;

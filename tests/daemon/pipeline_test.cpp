@@ -5,10 +5,12 @@
 #include "pipeline.hpp"
 
 #include <gtest/gtest.h>
+#include <pthread.h>
 #include <spdlog/sinks/ringbuffer_sink.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -104,8 +106,11 @@ class FakeOutlet final : public trajroi::daemon::Outlet {
       : slow_channel_(std::move(slow_channel)), delay_(delay) {}
   void publish(const std::string& channel, std::span<const std::uint8_t> bytes) override {
     if (channel == slow_channel_) std::this_thread::sleep_for(delay_);
+    std::array<char, 16> name{};
+    pthread_getname_np(pthread_self(), name.data(), name.size());
     std::lock_guard<std::mutex> lock(mutex_);
     messages_[channel].emplace_back(bytes.begin(), bytes.end());
+    senders_[channel].emplace_back(name.data());
   }
   bool subscribe(const std::string&, Handler) override { return true; }
   [[nodiscard]] int incoming_fd() const noexcept override { return -1; }
@@ -114,12 +119,18 @@ class FakeOutlet final : public trajroi::daemon::Outlet {
     std::lock_guard<std::mutex> lock(mutex_);
     return messages_[channel];
   }
+  // The name of the thread that published each message on `channel`, in order.
+  std::vector<std::string> senders(const std::string& channel) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return senders_[channel];
+  }
 
  private:
   std::string slow_channel_;
   std::chrono::milliseconds delay_{0};
   std::mutex mutex_;
   std::map<std::string, std::vector<std::vector<std::uint8_t>>> messages_;
+  std::map<std::string, std::vector<std::string>> senders_;
 };
 
 template <typename Message>
@@ -304,6 +315,47 @@ TEST(Pipeline, TheEvaluationKeepsExactlyWhatTheDaemonPublishes) {
     points += s.size();
   }
   EXPECT_GT(points, 1'000'000u);
+}
+
+// Live, a finished sweep goes out on the processing thread while the publisher thread is idle
+// (no wake-up between them); realtime.publish_from_processing: false hands every sweep to the
+// publisher thread. Either way the same messages, in the same order.
+TEST(Pipeline, LiveSweepsGoOutOnTheProcessingThreadWhileThePublisherIsIdle) {
+  const auto run = [](bool from_processing, FakeOutlet& outlet) {
+    DaemonConfig config = trajroi::daemon::load_daemon_config(corridor_run() / "trajroid.yaml");
+    config.realtime.publish_from_processing = from_processing;
+    // The run's first 4 s at four times real time, in one paced lane.
+    std::vector<Item> items = run_items({});
+    const std::int64_t end_ns = items.front().t_ns + 4'000'000'000;
+    std::erase_if(items, [end_ns](const Item& i) { return i.t_ns > end_ns; });
+    Pipeline pipeline(config, /*exact=*/false, /*record=*/false);
+    pipeline.add_input(std::make_unique<FakeInput>(std::move(items), 4.0), config.buffers.lidar_packets, "test-run",
+                       {});
+    SweepProcessor processor(config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
+    trajroi::daemon::RunOptions options;
+    options.replay = corridor_run();
+    EXPECT_EQ(trajroi::daemon::run_pipeline(pipeline, processor, outlet, options, /*signals=*/false), 0);
+    const auto last = decode<trajroi::status_t>(outlet.messages(config.lcm.status).back());
+    EXPECT_EQ(last.ring_drops, 0);
+    return config.lcm.points;
+  };
+  FakeOutlet inline_outlet, handed_outlet;
+  const std::string channel = run(true, inline_outlet);
+  (void)run(false, handed_outlet);
+
+  const std::vector<std::string> inline_senders = inline_outlet.senders(channel);
+  const std::vector<std::string> handed_senders = handed_outlet.senders(channel);
+  ASSERT_GT(inline_senders.size(), 30u);
+  // The publisher thread is busy only around its once-a-second status and its 100 ms checks.
+  const auto on = [](const std::vector<std::string>& senders, const std::string& thread) {
+    return std::count(senders.begin(), senders.end(), thread);
+  };
+  EXPECT_GE(on(inline_senders, "trajroid-proc"), static_cast<std::ptrdiff_t>(inline_senders.size()) * 9 / 10);
+  EXPECT_EQ(on(inline_senders, "trajroid-proc") + on(inline_senders, "trajroid-pub"),
+            static_cast<std::ptrdiff_t>(inline_senders.size()));
+  EXPECT_EQ(on(handed_senders, "trajroid-pub"), static_cast<std::ptrdiff_t>(handed_senders.size()));
+  EXPECT_TRUE(inline_outlet.messages(channel) == handed_outlet.messages(channel))
+      << inline_senders.size() << " and " << handed_senders.size() << " points messages";
 }
 
 // A sweep later than kLateSweep_ms from its last packet to LCM is counted (sweeps.late) and

@@ -189,6 +189,8 @@ struct DaemonConfig {
 
   struct Realtime {
     bool lock_memory = false;  // mlockall(MCL_CURRENT | MCL_FUTURE)
+    // Live: a sweep goes out on the processing thread when the publisher thread is idle.
+    bool publish_from_processing = true;
     ThreadConfig lidar, gnss, imu, processing, publisher;
   } realtime;
 };
