@@ -317,6 +317,20 @@ TEST(Pipeline, TheEvaluationKeepsExactlyWhatTheDaemonPublishes) {
   EXPECT_GT(points, 1'000'000u);
 }
 
+// The run's first `seconds` at `rate` × real time in one paced lane, through the daemon's
+// threads as live (a full ring drops), out through `outlet`.
+void run_live(const DaemonConfig& config, int seconds, double rate, FakeOutlet& outlet) {
+  std::vector<Item> items = run_items({});
+  const std::int64_t end_ns = items.front().t_ns + std::int64_t{seconds} * 1'000'000'000;
+  std::erase_if(items, [end_ns](const Item& i) { return i.t_ns > end_ns; });
+  Pipeline pipeline(config, /*exact=*/false, /*record=*/false);
+  pipeline.add_input(std::make_unique<FakeInput>(std::move(items), rate), config.buffers.lidar_packets, "test-run", {});
+  SweepProcessor processor(config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
+  trajroi::daemon::RunOptions options;
+  options.replay = corridor_run();
+  EXPECT_EQ(trajroi::daemon::run_pipeline(pipeline, processor, outlet, options, /*signals=*/false), 0);
+}
+
 // Live, a finished sweep goes out on the processing thread while the publisher thread is idle
 // (no wake-up between them); realtime.publish_from_processing: false hands every sweep to the
 // publisher thread. Either way the same messages, in the same order.
@@ -324,17 +338,7 @@ TEST(Pipeline, LiveSweepsGoOutOnTheProcessingThreadWhileThePublisherIsIdle) {
   const auto run = [](bool from_processing, FakeOutlet& outlet) {
     DaemonConfig config = trajroi::daemon::load_daemon_config(corridor_run() / "trajroid.yaml");
     config.realtime.publish_from_processing = from_processing;
-    // The run's first 4 s at four times real time, in one paced lane.
-    std::vector<Item> items = run_items({});
-    const std::int64_t end_ns = items.front().t_ns + 4'000'000'000;
-    std::erase_if(items, [end_ns](const Item& i) { return i.t_ns > end_ns; });
-    Pipeline pipeline(config, /*exact=*/false, /*record=*/false);
-    pipeline.add_input(std::make_unique<FakeInput>(std::move(items), 4.0), config.buffers.lidar_packets, "test-run",
-                       {});
-    SweepProcessor processor(config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
-    trajroi::daemon::RunOptions options;
-    options.replay = corridor_run();
-    EXPECT_EQ(trajroi::daemon::run_pipeline(pipeline, processor, outlet, options, /*signals=*/false), 0);
+    run_live(config, /*seconds=*/4, /*rate=*/4.0, outlet);
     const auto last = decode<trajroi::status_t>(outlet.messages(config.lcm.status).back());
     EXPECT_EQ(last.ring_drops, 0);
     return config.lcm.points;
@@ -364,21 +368,11 @@ TEST(Pipeline, LiveSweepsGoOutOnTheProcessingThreadWhileThePublisherIsIdle) {
 TEST(Pipeline, LateSweepsAreCounted) {
   const DaemonConfig config = trajroi::daemon::load_daemon_config(corridor_run() / "trajroid.yaml");
   FakeOutlet outlet(config.lcm.points, std::chrono::milliseconds(6));
-  // The run's first 6 s at twice real time, in one paced lane.
-  std::vector<Item> items = run_items({});
-  const std::int64_t end_ns = items.front().t_ns + 6'000'000'000;
-  std::erase_if(items, [end_ns](const Item& i) { return i.t_ns > end_ns; });
-  Pipeline pipeline(config, /*exact=*/false, /*record=*/false);
-  pipeline.add_input(std::make_unique<FakeInput>(std::move(items), 2.0), config.buffers.lidar_packets, "test-run", {});
-  trajroi::pipeline::SweepProcessor processor(
-      config, trajroi::daemon::load_trajectory(trajroi::daemon::TrajectorySource::from(config)));
-  trajroi::daemon::RunOptions options;
-  options.replay = corridor_run();
   // The daemon's log lines, kept for reading back.
   auto lines = std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(256);
   auto& sinks = spdlog::default_logger()->sinks();
   sinks.push_back(lines);
-  EXPECT_EQ(trajroi::daemon::run_pipeline(pipeline, processor, outlet, options, /*signals=*/false), 0);
+  run_live(config, /*seconds=*/6, /*rate=*/2.0, outlet);
   sinks.pop_back();
 
   const auto published = outlet.messages(config.lcm.points);
